@@ -1,0 +1,2 @@
+// placeholder replaced by the mrf command line
+int main() { return 0; }

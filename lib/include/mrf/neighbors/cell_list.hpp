@@ -1,0 +1,69 @@
+// Cell-list neighbour search in the shear-cell box (periodic in y and z,
+// bounded in x). Built from positions and a box only; knows no physics.
+#pragma once
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "mrf/box.hpp"
+
+namespace mrf {
+
+using IndexPair = std::pair<std::uint32_t, std::uint32_t>;
+
+// A uniform grid of cells no smaller than `min_cell` along each axis.
+// Along y or z a periodic direction with fewer than 3 cells is collapsed to
+// one cell (every point is then a candidate along it), which keeps the
+// search correct for any box.
+class CellGrid {
+ public:
+  CellGrid(const Box& box, double x_lo, double x_hi, double min_cell);
+
+  // Sort points into cells (counting sort; no allocation after the first call
+  // with the same number of points).
+  void bin(const std::vector<Vec3>& pts);
+
+  // Call f(j) for every binned point j in the 27 cells around position p
+  // (each point at most once).
+  template <class F>
+  void for_each_candidate(const Vec3& p, F&& f) const {
+    const int cx = cell_x(p.x()), cy = cell_y(p.y()), cz = cell_z(p.z());
+    const int dx_lo = cx > 0 ? -1 : 0, dx_hi = cx < nx_ - 1 ? 1 : 0;
+    const int dy_lo = ny_ >= 3 ? -1 : 0, dy_hi = ny_ >= 3 ? 1 : 0;
+    const int dz_lo = nz_ >= 3 ? -1 : 0, dz_hi = nz_ >= 3 ? 1 : 0;
+    for (int dx = dx_lo; dx <= dx_hi; ++dx)
+      for (int dy = dy_lo; dy <= dy_hi; ++dy)
+        for (int dz = dz_lo; dz <= dz_hi; ++dz) {
+          const int c = index(cx + dx, (cy + dy + ny_) % ny_, (cz + dz + nz_) % nz_);
+          for (std::uint32_t k = start_[c]; k < start_[c + 1]; ++k) f(order_[k]);
+        }
+  }
+
+  int cells() const { return nx_ * ny_ * nz_; }
+
+ private:
+  int cell_x(double x) const;
+  int cell_y(double y) const;
+  int cell_z(double z) const;
+  int index(int ix, int iy, int iz) const { return (ix * ny_ + iy) * nz_ + iz; }
+
+  Box box_;
+  double x_lo_, inv_wx_, inv_wy_, inv_wz_;
+  int nx_, ny_, nz_;
+  std::vector<std::uint32_t> start_, order_, cell_of_, fill_;
+};
+
+// All pairs i < j of `pts` closer than `cutoff` (minimum image), via cells.
+std::vector<IndexPair> self_pairs(const std::vector<Vec3>& pts, const Box& box, double cutoff);
+// All pairs (i in a, j in b) closer than `cutoff`, via cells.
+std::vector<IndexPair> cross_pairs(const std::vector<Vec3>& a, const std::vector<Vec3>& b,
+                                   const Box& box, double cutoff);
+
+// O(N^2) oracles for tests.
+std::vector<IndexPair> brute_force_self_pairs(const std::vector<Vec3>& pts, const Box& box,
+                                              double cutoff);
+std::vector<IndexPair> brute_force_cross_pairs(const std::vector<Vec3>& a,
+                                               const std::vector<Vec3>& b, const Box& box,
+                                               double cutoff);
+
+}  // namespace mrf

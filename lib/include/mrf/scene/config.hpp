@@ -1,0 +1,60 @@
+// A validated scene: every parameter of a run in SI units, as read from a
+// scene file (io/toml_scene.hpp) or built by a test. Defaults are documented
+// here and in docs/scene-format.md.
+#pragma once
+#include <cstdint>
+#include <optional>
+#include <string>
+
+namespace mrf {
+
+enum class ModelId { dem_stokes, demsph_stokes, demsph_dd };
+enum class IntegratorId { automatic, verlet_exp, overdamped, implicit };
+
+const char* to_string(ModelId m);
+const char* to_string(IntegratorId i);
+
+struct SceneConfig {
+  // [scene]
+  ModelId model = ModelId::dem_stokes;
+  std::uint64_t seed = 1;
+  // [box] (m)
+  double gap = 0, ly = 0, lz = 0;
+  // [particles]
+  double radius = 0;           // m
+  double volume_fraction = 0;  // n V_p / (gap ly lz), 0 allowed (no magnetic particles)
+  double density = 0;          // kg/m^3
+  double magnetization = 0;    // A/m, fixed along +x
+  double dipole_cutoff = 0;    // m, centre-centre distance beyond which dipole forces vanish
+  // [walls]
+  double wall_spacing = 0;     // m, lattice spacing of the wall spheres in y and z
+  // [contact]
+  double youngs_modulus = 0;   // Pa
+  double poisson_ratio = 0;    // 1
+  // [fluid]
+  double viscosity = 0;        // Pa s
+  double fluid_density = 0;    // kg/m^3
+  double sph_spacing = 0;      // m, SPH particle spacing (SPH models only)
+  double sound_speed = 0;      // m/s (SPH models only; 0 = choose from 1 % density variation)
+  // [drive]: exactly one of mason, shear_rate is given in the file; both are
+  // filled in after validation (Mn = 9 eta gdot / (2 mu0 M^2), DESIGN.md).
+  double mason = 0;
+  double shear_rate = 0;       // 1/s
+  double strain = 0;           // total strain of the run
+  double warmup_strain = 0;    // strain discarded before averaging
+  // [numerics]
+  IntegratorId integrator = IntegratorId::automatic;
+  std::optional<double> dt;    // s; empty = automatic
+  double skin = 0;             // m, Verlet skin; 0 = 0.2 radius
+  double dt_safety = 0.5;      // fraction of the smallest stability limit used by automatic dt
+  int threads = 0;             // OpenMP threads; 0 = OMP default
+  // [output]
+  int every = 0;               // steps between time-series rows; 0 = about 2000 rows per run
+  int frames = 0;              // number of particle frames written (0 = none)
+};
+
+// Mason number from shear rate and back (DESIGN.md convention).
+double mason_from_shear_rate(double shear_rate, double viscosity, double magnetization);
+double shear_rate_from_mason(double mason, double viscosity, double magnetization);
+
+}  // namespace mrf

@@ -1,0 +1,119 @@
+#include "mrf/neighbors/cell_list.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace mrf {
+
+namespace {
+int cells_along(double length, double min_cell) {
+  return std::max(1, static_cast<int>(std::floor(length / min_cell)));
+}
+void extent(const std::vector<Vec3>& a, double& lo, double& hi) {
+  for (const Vec3& p : a) {
+    lo = std::min(lo, p.x());
+    hi = std::max(hi, p.x());
+  }
+}
+}  // namespace
+
+CellGrid::CellGrid(const Box& box, double x_lo, double x_hi, double min_cell)
+    : box_(box), x_lo_(x_lo) {
+  nx_ = cells_along(x_hi - x_lo, min_cell);
+  ny_ = cells_along(box.ly, min_cell);
+  nz_ = cells_along(box.lz, min_cell);
+  if (ny_ < 3) ny_ = 1;
+  if (nz_ < 3) nz_ = 1;
+  inv_wx_ = nx_ / std::max(x_hi - x_lo, std::numeric_limits<double>::min());
+  inv_wy_ = ny_ / box.ly;
+  inv_wz_ = nz_ / box.lz;
+}
+
+int CellGrid::cell_x(double x) const {
+  return std::clamp(static_cast<int>((x - x_lo_) * inv_wx_), 0, nx_ - 1);
+}
+int CellGrid::cell_y(double y) const {
+  const double w = y - box_.ly * std::floor(y / box_.ly);
+  return std::clamp(static_cast<int>(w * inv_wy_), 0, ny_ - 1);
+}
+int CellGrid::cell_z(double z) const {
+  const double w = z - box_.lz * std::floor(z / box_.lz);
+  return std::clamp(static_cast<int>(w * inv_wz_), 0, nz_ - 1);
+}
+
+void CellGrid::bin(const std::vector<Vec3>& pts) {
+  const int nc = cells();
+  start_.assign(nc + 1, 0);
+  cell_of_.resize(pts.size());
+  order_.resize(pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const int c = index(cell_x(pts[i].x()), cell_y(pts[i].y()), cell_z(pts[i].z()));
+    cell_of_[i] = static_cast<std::uint32_t>(c);
+    ++start_[c + 1];
+  }
+  for (int c = 0; c < nc; ++c) start_[c + 1] += start_[c];
+  fill_.assign(start_.begin(), start_.end() - 1);
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    order_[fill_[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
+}
+
+std::vector<IndexPair> self_pairs(const std::vector<Vec3>& pts, const Box& box, double cutoff) {
+  std::vector<IndexPair> out;
+  if (pts.empty()) return out;
+  double lo = std::numeric_limits<double>::max(), hi = std::numeric_limits<double>::lowest();
+  extent(pts, lo, hi);
+  CellGrid grid(box, lo, hi, cutoff);
+  grid.bin(pts);
+  const double rc2 = cutoff * cutoff;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    grid.for_each_candidate(pts[i], [&](std::uint32_t j) {
+      if (j <= i) return;
+      if (box.min_image(pts[i] - pts[j]).squaredNorm() < rc2)
+        out.emplace_back(static_cast<std::uint32_t>(i), j);
+    });
+  }
+  return out;
+}
+
+std::vector<IndexPair> cross_pairs(const std::vector<Vec3>& a, const std::vector<Vec3>& b,
+                                   const Box& box, double cutoff) {
+  std::vector<IndexPair> out;
+  if (a.empty() || b.empty()) return out;
+  double lo = std::numeric_limits<double>::max(), hi = std::numeric_limits<double>::lowest();
+  extent(a, lo, hi);
+  extent(b, lo, hi);
+  CellGrid grid(box, lo, hi, cutoff);
+  grid.bin(b);
+  const double rc2 = cutoff * cutoff;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    grid.for_each_candidate(a[i], [&](std::uint32_t j) {
+      if (box.min_image(a[i] - b[j]).squaredNorm() < rc2)
+        out.emplace_back(static_cast<std::uint32_t>(i), j);
+    });
+  }
+  return out;
+}
+
+std::vector<IndexPair> brute_force_self_pairs(const std::vector<Vec3>& pts, const Box& box,
+                                              double cutoff) {
+  std::vector<IndexPair> out;
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    for (std::size_t j = i + 1; j < pts.size(); ++j)
+      if (box.min_image(pts[i] - pts[j]).squaredNorm() < cutoff * cutoff)
+        out.emplace_back(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j));
+  return out;
+}
+
+std::vector<IndexPair> brute_force_cross_pairs(const std::vector<Vec3>& a,
+                                               const std::vector<Vec3>& b, const Box& box,
+                                               double cutoff) {
+  std::vector<IndexPair> out;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    for (std::size_t j = 0; j < b.size(); ++j)
+      if (box.min_image(a[i] - b[j]).squaredNorm() < cutoff * cutoff)
+        out.emplace_back(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j));
+  return out;
+}
+
+}  // namespace mrf

@@ -1,0 +1,34 @@
+#include "mrf/scene/config.hpp"
+
+#include "mrf/vec.hpp"
+
+namespace mrf {
+
+const char* to_string(ModelId m) {
+  switch (m) {
+    case ModelId::dem_stokes: return "dem_stokes";
+    case ModelId::demsph_stokes: return "demsph_stokes";
+    case ModelId::demsph_dd: return "demsph_dd";
+  }
+  return "?";
+}
+
+const char* to_string(IntegratorId i) {
+  switch (i) {
+    case IntegratorId::automatic: return "auto";
+    case IntegratorId::verlet_exp: return "verlet_exp";
+    case IntegratorId::overdamped: return "overdamped";
+    case IntegratorId::implicit: return "implicit";
+  }
+  return "?";
+}
+
+double mason_from_shear_rate(double shear_rate, double viscosity, double magnetization) {
+  return 9.0 * viscosity * shear_rate / (2.0 * k_mu0 * magnetization * magnetization);
+}
+
+double shear_rate_from_mason(double mason, double viscosity, double magnetization) {
+  return mason * 2.0 * k_mu0 * magnetization * magnetization / (9.0 * viscosity);
+}
+
+}  // namespace mrf

@@ -1,0 +1,74 @@
+// Cell list against the brute-force oracle: identical pair sets on random
+// periodic configurations, including boxes too small for 3 cells per axis.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+#include "mrf/neighbors/cell_list.hpp"
+
+namespace mrf {
+namespace {
+
+std::vector<Vec3> random_points(std::size_t n, const Box& box, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> ux(-box.gap / 2, box.gap / 2), uy(0, box.ly),
+      uz(0, box.lz);
+  std::vector<Vec3> p(n);
+  for (auto& q : p) q = Vec3(ux(rng), uy(rng), uz(rng));
+  return p;
+}
+
+std::vector<IndexPair> sorted(std::vector<IndexPair> v) {
+  std::sort(v.begin(), v.end());
+  return v;
+}
+
+struct Case {
+  Box box;
+  double cutoff;
+};
+
+class CellListVsBruteForce : public ::testing::TestWithParam<Case> {};
+
+TEST_P(CellListVsBruteForce, SelfPairsIdentical) {
+  const auto [box, rc] = GetParam();
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    const auto pts = random_points(400, box, seed);
+    const auto ref = sorted(brute_force_self_pairs(pts, box, rc));
+    ASSERT_FALSE(ref.empty());
+    EXPECT_EQ(sorted(self_pairs(pts, box, rc)), ref) << "seed " << seed;
+  }
+}
+
+TEST_P(CellListVsBruteForce, CrossPairsIdentical) {
+  const auto [box, rc] = GetParam();
+  const auto a = random_points(300, box, 11);
+  const auto b = random_points(200, box, 12);
+  const auto ref = sorted(brute_force_cross_pairs(a, b, box, rc));
+  ASSERT_FALSE(ref.empty());
+  EXPECT_EQ(sorted(cross_pairs(a, b, box, rc)), ref);
+}
+
+INSTANTIATE_TEST_SUITE_P(Boxes, CellListVsBruteForce,
+                         ::testing::Values(Case{{10.0, 10.0, 10.0}, 1.5},   // many cells
+                                           Case{{10.0, 4.0, 10.0}, 1.5},    // 2 cells in y
+                                           Case{{3.0, 10.0, 2.5}, 1.1},     // 2 cells in z
+                                           Case{{10.0, 7.0, 9.0}, 2.9}));   // uneven widths
+
+TEST(CellList, PeriodicImageIsFound) {
+  const Box box{10.0, 10.0, 10.0};
+  const std::vector<Vec3> pts{Vec3(0, 0.1, 5), Vec3(0, 9.9, 5)};
+  const auto pairs = self_pairs(pts, box, 0.5);
+  ASSERT_EQ(pairs.size(), 1u);
+  EXPECT_EQ(pairs[0], IndexPair(0, 1));
+}
+
+TEST(CellList, XIsNotPeriodic) {
+  const Box box{10.0, 10.0, 10.0};
+  const std::vector<Vec3> pts{Vec3(-4.9, 5, 5), Vec3(4.9, 5, 5)};
+  EXPECT_TRUE(self_pairs(pts, box, 0.5).empty());
+}
+
+}  // namespace
+}  // namespace mrf
