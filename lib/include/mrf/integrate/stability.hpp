@@ -1,0 +1,48 @@
+// Time-step limits of the DEM schemes (REFERENCE.md §2, §3). Each limit is
+// {name, dt}; the automatic step is a safety fraction of the smallest one.
+#pragma once
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "mrf/scene/config.hpp"
+#include "mrf/scene/dem_params.hpp"
+
+namespace mrf {
+
+struct StabilityLimit {
+  std::string name;
+  double dt;          // s; infinity when the scheme is not bound by it
+  std::string basis;  // how it was computed, for the start-up printout
+};
+
+// Largest stable dt of the verlet_exp scheme (kick / exact drag-drift / kick)
+// for a damped oscillator r'' = -omega^2 r - r'/tau: found from the spectral
+// radius of the scheme's 2x2 amplification matrix, so it is exact for the
+// scheme, from the inertial (dt ~ 2/omega) to the overdamped regime.
+double verlet_exp_oscillator_limit(double omega, double tau);
+// Spectral radius of that amplification matrix (exposed for tests).
+double verlet_exp_amplification(double omega, double tau, double dt);
+
+// Explicit-Euler overdamped limit for a pair of free spheres: dt < gamma/k_eff.
+double overdamped_contact_limit(double gamma, double k_eff);
+
+// Local Hertz stiffness at the overlap reached under `load` (N/m).
+double contact_stiffness_at_load(double hertz_k, double load);
+
+// All limits of a DEM scene for the given scheme (verlet_exp or overdamped).
+std::vector<StabilityLimit> dem_limits(const DemParams& p, const SceneConfig& c, IntegratorId scheme);
+
+// Contact limit for the largest overlap actually seen (checked during a run).
+double contact_limit_at_overlap(const DemParams& p, IntegratorId scheme, double overlap);
+
+double smallest(const std::vector<StabilityLimit>& limits);
+const StabilityLimit& binding(const std::vector<StabilityLimit>& limits);
+
+}  // namespace mrf
+
+namespace mrf {
+// Largest overlap (m) whose Hertz stiffness the scheme still integrates
+// stably at time step dt (bisection on the monotone contact limit).
+double critical_overlap(const DemParams& p, IntegratorId scheme, double dt);
+}  // namespace mrf

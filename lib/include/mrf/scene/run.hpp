@@ -1,0 +1,53 @@
+// One run of a scene: choose the integrator and time step from the stability
+// limits, integrate to the requested strain, write timeseries.csv and
+// summary.json, and return the summary.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "mrf/integrate/stability.hpp"
+#include "mrf/io/toml_scene.hpp"
+
+namespace mrf {
+
+struct TimeStepChoice {
+  IntegratorId scheme;
+  double dt;                            // s
+  std::vector<StabilityLimit> limits;   // of the chosen scheme
+  std::vector<StabilityLimit> other;    // of the scheme not chosen (for the printout)
+};
+
+// Automatic choice: the scheme whose smallest limit is largest (auto), and
+// dt = dt_safety * smallest limit; a user dt above the smallest limit is an
+// InputError on numerics.dt naming the binding limit.
+TimeStepChoice choose_time_step(const LoadedScene& scene, const DemParams& p);
+
+struct RunOptions {
+  std::string out_dir;  // empty: write nothing
+  bool quiet = false;   // no progress or start-up table on stderr
+};
+
+struct Measurement {
+  double mean = 0, err = 0, drift_z = 0;
+};
+
+struct RunSummary {
+  std::string model, integrator, binding_limit;
+  double mason = 0, shear_rate = 0, strain = 0, warmup_strain = 0, dt = 0;
+  Measurement stress_total, stress_particles, stress_virial, stress_virial_magnetic,
+      stress_virial_contact, wall_minus_virial;
+  double stress_fluid = 0;
+  long n_particles = 0, n_wall = 0, n_fluid = 0, steps = 0, neighbor_builds = 0;
+  double wall_seconds = 0, particle_steps_per_second = 0, pair_evaluations_per_second = 0;
+  double stokes_number = 0, reynolds_number = 0, max_overlap_over_radius = 0;
+  double youngs_modulus = 0, density = 0, magnetization = 0, volume_fraction = 0;
+  std::uint64_t seed = 0;
+  int threads = 1;
+};
+
+RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt);
+
+// summary.json text of a run (every key of DESIGN.md plus the extras above).
+std::string summary_json(const RunSummary& s);
+
+}  // namespace mrf

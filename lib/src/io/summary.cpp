@@ -1,0 +1,51 @@
+#include <nlohmann/json.hpp>
+
+#include "mrf/scene/run.hpp"
+
+namespace mrf {
+
+std::string summary_json(const RunSummary& s) {
+  nlohmann::ordered_json j;
+  auto put = [&j](const std::string& key, const Measurement& m) {
+    j[key] = m.mean;
+    j[key + "_err"] = m.err;
+    j[key + "_drift_z"] = m.drift_z;
+  };
+  j["model"] = s.model;
+  j["mason"] = s.mason;
+  j["mason_convention"] = "Mn = 9 eta gdot / (2 mu0 M^2)";
+  j["shear_rate"] = s.shear_rate;
+  j["strain"] = s.strain;
+  j["warmup_strain"] = s.warmup_strain;
+  put("stress_total", s.stress_total);
+  put("stress_particles", s.stress_particles);
+  j["stress_fluid"] = s.stress_fluid;
+  put("stress_virial", s.stress_virial);
+  put("stress_virial_magnetic", s.stress_virial_magnetic);
+  put("stress_virial_contact", s.stress_virial_contact);
+  put("stress_wall_minus_virial", s.wall_minus_virial);
+  j["n_particles"] = s.n_particles;
+  j["n_wall"] = s.n_wall;
+  j["n_fluid"] = s.n_fluid;
+  j["integrator"] = s.integrator;
+  j["dt"] = s.dt;
+  j["dt_bound_by"] = s.binding_limit;
+  j["steps"] = s.steps;
+  j["neighbor_builds"] = s.neighbor_builds;
+  j["wall_seconds"] = s.wall_seconds;
+  j["particle_steps_per_second"] = s.particle_steps_per_second;
+  j["pair_evaluations_per_second"] = s.pair_evaluations_per_second;
+  j["threads"] = s.threads;
+  j["stokes_number"] = s.stokes_number;
+  j["reynolds_number"] = s.reynolds_number;
+  j["max_overlap_over_radius"] = s.max_overlap_over_radius;
+  j["youngs_modulus"] = s.youngs_modulus;
+  j["particle_density"] = s.density;
+  j["magnetization"] = s.magnetization;
+  j["volume_fraction"] = s.volume_fraction;
+  j["seed"] = s.seed;
+  j["version"] = MRF_VERSION;
+  return j.dump(2);
+}
+
+}  // namespace mrf

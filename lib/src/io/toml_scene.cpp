@@ -1,0 +1,591 @@
+// Scene file loader. One table of key specs (k_keys) drives reading, defaults
+// and missing-key checks; one table of rules (k_rules) drives validation.
+// Quantities are plain numbers (SI) or strings "<number> <unit>" (k_units).
+#include "mrf/io/toml_scene.hpp"
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <optional>
+#include <sstream>
+#include <variant>
+
+#include "mrf/error.hpp"
+
+namespace mrf {
+namespace {
+
+// ---- units ---------------------------------------------------------------
+
+enum class Dim { none, length, time, pressure, viscosity, density, magnetization, rate, velocity };
+
+struct Unit {
+  Dim dim;
+  std::string_view name;  // after normalize_unit
+  double factor;          // to SI
+};
+
+// The first unit of each dimension is the SI unit of a plain number.
+constexpr Unit k_units[] = {
+    {Dim::length, "m", 1},          {Dim::length, "mm", 1e-3},       {Dim::length, "um", 1e-6},
+    {Dim::length, "nm", 1e-9},      {Dim::time, "s", 1},             {Dim::time, "ms", 1e-3},
+    {Dim::time, "us", 1e-6},        {Dim::time, "ns", 1e-9},         {Dim::pressure, "Pa", 1},
+    {Dim::pressure, "kPa", 1e3},    {Dim::pressure, "MPa", 1e6},     {Dim::pressure, "GPa", 1e9},
+    {Dim::viscosity, "Pa s", 1},    {Dim::viscosity, "Pa*s", 1},     {Dim::viscosity, "mPa s", 1e-3},
+    {Dim::viscosity, "mPa*s", 1e-3}, {Dim::density, "kg/m^3", 1},    {Dim::density, "kg/m3", 1},
+    {Dim::density, "g/cm^3", 1e3},  {Dim::density, "g/cm3", 1e3},    {Dim::magnetization, "A/m", 1},
+    {Dim::magnetization, "kA/m", 1e3}, {Dim::magnetization, "MA/m", 1e6}, {Dim::rate, "1/s", 1},
+    {Dim::rate, "s^-1", 1},         {Dim::velocity, "m/s", 1},
+};
+
+std::string_view noun(Dim d) {
+  switch (d) {
+    case Dim::none: return "a dimensionless number";
+    case Dim::length: return "a length";
+    case Dim::time: return "a time";
+    case Dim::pressure: return "a pressure";
+    case Dim::viscosity: return "a viscosity";
+    case Dim::density: return "a density";
+    case Dim::magnetization: return "a magnetization";
+    case Dim::rate: return "a rate";
+    case Dim::velocity: return "a velocity";
+  }
+  return "?";
+}
+
+std::string unit_list(Dim d) {
+  std::string s;
+  for (const Unit& u : k_units)
+    if (u.dim == d) s += (s.empty() ? "" : ", ") + std::string(u.name);
+  return s;
+}
+
+std::string_view trim(std::string_view s) {
+  const auto b = s.find_first_not_of(" \t\r\n");
+  if (b == std::string_view::npos) return {};
+  return s.substr(b, s.find_last_not_of(" \t\r\n") - b + 1);
+}
+
+// Micro sign (U+00B5) and Greek mu (U+03BC) become 'u'; runs of blanks one space.
+std::string normalize_unit(std::string_view u) {
+  std::string s;
+  for (std::size_t i = 0; i < u.size(); ++i) {
+    const std::string_view rest = u.substr(i);
+    if (rest.starts_with("\u00b5") || rest.starts_with("\u03bc")) {
+      s += 'u';
+      ++i;  // both are two bytes in UTF-8
+    } else if (u[i] == ' ' || u[i] == '\t') {
+      if (s.empty() || s.back() != ' ') s += ' ';
+    } else {
+      s += u[i];
+    }
+  }
+  return s;
+}
+
+// ---- values as written ---------------------------------------------------
+
+// One value from the file or an override, before conversion.
+struct Value {
+  std::variant<std::monostate, std::int64_t, double, bool, std::string> v;  // monostate: array...
+  std::string text;   // as shown in messages
+  std::string where;  // "FILE:LINE" or "--set key=value"
+};
+
+// Thrown by the readers; the caller adds key, value and location.
+struct Reject {
+  std::string why;
+};
+
+std::string format_number(double x) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, x);
+  return std::string(buf, r.ptr);
+}
+
+Value value_of(const toml::node& n, std::string where) {
+  Value out{std::monostate{}, "", std::move(where)};
+  if (const auto* i = n.as_integer()) {
+    out.v = i->get();
+    out.text = std::to_string(i->get());
+  } else if (const auto* d = n.as_floating_point()) {
+    out.v = d->get();
+    out.text = format_number(d->get());
+  } else if (const auto* b = n.as_boolean()) {
+    out.v = b->get();
+    out.text = b->get() ? "true" : "false";
+  } else if (const auto* s = n.as_string()) {
+    out.v = s->get();
+    out.text = "\"" + s->get() + "\"";
+  } else if (!n.is_table()) {
+    std::ostringstream os;
+    os << toml::toml_formatter{n};
+    out.text = os.str();
+  }
+  return out;
+}
+
+// "<number> <unit>" or "<number>" -> SI value.
+double parse_quantity(const std::string& s, Dim dim) {
+  std::string_view t = trim(s);
+  if (t.starts_with('+')) t.remove_prefix(1);
+  double x = 0;
+  const auto r = std::from_chars(t.data(), t.data() + t.size(), x);
+  if (r.ec == std::errc::result_out_of_range) throw Reject{"number out of range"};
+  if (r.ec != std::errc()) throw Reject{"expected a number, or a string like \"2.5 um\""};
+  if (!std::isfinite(x)) throw Reject{"not a finite number"};
+  const std::string written(trim(std::string_view(r.ptr, t.data() + t.size() - r.ptr)));
+  const std::string unit = normalize_unit(written);
+  if (dim == Dim::none) {
+    if (!unit.empty()) throw Reject{"a dimensionless number takes no unit (got '" + written + "')"};
+    return x;
+  }
+  const std::string expected = std::string(noun(dim)) + " (expected " + unit_list(dim);
+  if (unit.empty()) throw Reject{"missing unit for " + expected + ")"};
+  for (const Unit& u : k_units) {
+    if (u.name != unit) continue;
+    if (u.dim != dim) throw Reject{"wrong unit '" + written + "' for " + expected + ")"};
+    return x * u.factor;
+  }
+  throw Reject{"unknown unit '" + written + "' for " + expected + ")"};
+}
+
+double read_number(const Value& val, Dim dim) {
+  if (const auto* i = std::get_if<std::int64_t>(&val.v)) return static_cast<double>(*i);
+  if (const auto* d = std::get_if<double>(&val.v)) {
+    if (!std::isfinite(*d)) throw Reject{"not a finite number"};
+    return *d;
+  }
+  if (const auto* s = std::get_if<std::string>(&val.v)) return parse_quantity(*s, dim);
+  throw Reject{dim == Dim::none ? "expected a number"
+                                : "expected a number (SI) or a string like \"2.5 um\""};
+}
+
+template <class Int>
+Int read_count(const Value& val) {
+  const auto* i = std::get_if<std::int64_t>(&val.v);
+  if (!i) throw Reject{"expected an integer"};
+  if (*i < 0) throw Reject{"must be an integer >= 0"};
+  if (static_cast<std::uint64_t>(*i) > static_cast<std::uint64_t>(std::numeric_limits<Int>::max()))
+    throw Reject{"integer too large"};
+  return static_cast<Int>(*i);
+}
+
+template <class E, std::size_t N>
+E read_choice(const Value& val, const E (&all)[N]) {
+  if (const auto* s = std::get_if<std::string>(&val.v))
+    for (E e : all)
+      if (*s == to_string(e)) return e;
+  std::string list;
+  for (E e : all) list += (list.empty() ? "" : ", ") + std::string(to_string(e));
+  throw Reject{"expected one of: " + list};
+}
+
+// ---- the key table -------------------------------------------------------
+
+enum class Need { required, optional, sph_models, one_of_drive };
+
+// Allowed interval of a number (open ends are strict), checked as it is read.
+struct Range {
+  double lo, hi;
+  bool lo_open, hi_open;
+};
+constexpr double k_inf = std::numeric_limits<double>::infinity();
+constexpr Range k_any{-k_inf, k_inf, false, false};
+constexpr Range k_pos{0, k_inf, true, false};
+constexpr Range k_nonneg{0, k_inf, false, false};
+
+bool inside(double x, const Range& r) {
+  return (r.lo_open ? x > r.lo : x >= r.lo) && (r.hi_open ? x < r.hi : x <= r.hi);
+}
+
+std::string describe(const Range& r) {
+  if (r.hi == k_inf) return (r.lo_open ? "must be > " : "must be >= ") + format_number(r.lo);
+  return std::string("must be in ") + (r.lo_open ? "(" : "[") + format_number(r.lo) + ", " +
+         format_number(r.hi) + (r.hi_open ? ")" : "]");
+}
+
+using Target = std::variant<double SceneConfig::*, int SceneConfig::*, std::uint64_t SceneConfig::*,
+                            ModelId SceneConfig::*, IntegratorId SceneConfig::*,
+                            std::optional<double> SceneConfig::*>;
+
+struct KeySpec {
+  std::string_view key;  // "section.name"
+  Target target;
+  Dim dim;
+  Need need;
+  Range range;  // numbers only; integers are >= 0
+};
+
+using C = SceneConfig;
+const KeySpec k_keys[] = {
+    {"scene.model", &C::model, Dim::none, Need::required, k_any},
+    {"scene.seed", &C::seed, Dim::none, Need::required, k_any},
+    {"box.gap", &C::gap, Dim::length, Need::required, k_pos},
+    {"box.ly", &C::ly, Dim::length, Need::required, k_pos},
+    {"box.lz", &C::lz, Dim::length, Need::required, k_pos},
+    {"particles.radius", &C::radius, Dim::length, Need::required, k_pos},
+    {"particles.volume_fraction", &C::volume_fraction, Dim::none, Need::required, {0, 1, false, true}},
+    {"particles.density", &C::density, Dim::density, Need::required, k_pos},
+    {"particles.magnetization", &C::magnetization, Dim::magnetization, Need::required, k_nonneg},
+    {"particles.dipole_cutoff", &C::dipole_cutoff, Dim::length, Need::required, k_pos},
+    {"walls.spacing", &C::wall_spacing, Dim::length, Need::required, k_pos},
+    {"contact.youngs_modulus", &C::youngs_modulus, Dim::pressure, Need::required, k_pos},
+    {"contact.poisson_ratio", &C::poisson_ratio, Dim::none, Need::required, {-1, 0.5, true, true}},
+    {"fluid.viscosity", &C::viscosity, Dim::viscosity, Need::required, k_pos},
+    {"fluid.density", &C::fluid_density, Dim::density, Need::required, k_pos},
+    {"fluid.sph_spacing", &C::sph_spacing, Dim::length, Need::sph_models, k_pos},
+    {"fluid.sound_speed", &C::sound_speed, Dim::velocity, Need::optional, k_nonneg},
+    {"drive.mason", &C::mason, Dim::none, Need::one_of_drive, k_pos},
+    {"drive.shear_rate", &C::shear_rate, Dim::rate, Need::one_of_drive, k_pos},
+    {"drive.strain", &C::strain, Dim::none, Need::required, k_pos},
+    {"drive.warmup_strain", &C::warmup_strain, Dim::none, Need::required, k_nonneg},
+    {"numerics.integrator", &C::integrator, Dim::none, Need::optional, k_any},
+    {"numerics.dt", &C::dt, Dim::time, Need::optional, k_pos},
+    {"numerics.skin", &C::skin, Dim::length, Need::optional, k_nonneg},
+    {"numerics.dt_safety", &C::dt_safety, Dim::none, Need::optional, {0, 1, true, false}},
+    {"numerics.threads", &C::threads, Dim::none, Need::optional, k_any},
+    {"output.every", &C::every, Dim::none, Need::optional, k_any},
+    {"output.frames", &C::frames, Dim::none, Need::optional, k_any},
+};
+
+constexpr ModelId k_models[] = {ModelId::dem_stokes, ModelId::demsph_stokes, ModelId::demsph_dd};
+constexpr IntegratorId k_integrators[] = {IntegratorId::automatic, IntegratorId::verlet_exp,
+                                          IntegratorId::overdamped, IntegratorId::implicit};
+
+double read_in_range(const Value& val, const KeySpec& spec) {
+  const double x = read_number(val, spec.dim);
+  if (!inside(x, spec.range)) throw Reject{describe(spec.range)};
+  return x;
+}
+
+template <class... F>
+struct Overloaded : F... {
+  using F::operator()...;
+};
+
+void assign(SceneConfig& c, const KeySpec& spec, const Value& val) {
+  std::visit(Overloaded{
+                 [&](double C::*m) { c.*m = read_in_range(val, spec); },
+                 [&](int C::*m) { c.*m = read_count<int>(val); },
+                 [&](std::uint64_t C::*m) { c.*m = read_count<std::uint64_t>(val); },
+                 [&](ModelId C::*m) { c.*m = read_choice(val, k_models); },
+                 [&](IntegratorId C::*m) { c.*m = read_choice(val, k_integrators); },
+                 [&](std::optional<double> C::*m) {
+                   const auto* s = std::get_if<std::string>(&val.v);
+                   c.*m = s && trim(*s) == "auto" ? std::optional<double>{} : read_in_range(val, spec);
+                 },
+             },
+             spec.target);
+}
+
+const KeySpec* find_spec(std::string_view key) {
+  for (const KeySpec& s : k_keys)
+    if (s.key == key) return &s;
+  return nullptr;
+}
+
+std::string_view section_of(std::string_view key) { return key.substr(0, key.find('.')); }
+std::string_view name_of(std::string_view key) {
+  const auto dot = key.find('.');
+  return dot == std::string_view::npos ? key : key.substr(dot + 1);
+}
+bool is_section(std::string_view name) {
+  return std::any_of(std::begin(k_keys), std::end(k_keys),
+                     [&](const KeySpec& s) { return section_of(s.key) == name; });
+}
+
+// ---- unknown keys: suggestions -------------------------------------------
+
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diag = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diag = up;
+    }
+  }
+  return row[b.size()];
+}
+
+// The same name in another section, else the closest key (or section) within distance 2.
+std::string suggestion(std::string_view wrong, bool want_section) {
+  std::string best;
+  std::size_t best_d = 3;
+  for (const KeySpec& s : k_keys) {
+    const std::string_view cand = want_section ? section_of(s.key) : s.key;
+    if (!want_section && name_of(s.key) == name_of(wrong)) return std::string(cand);
+    const std::size_t d = edit_distance(wrong, cand);
+    if (d < best_d) {
+      best = cand;
+      best_d = d;
+    }
+  }
+  return best;
+}
+
+std::string unknown_why(const std::string& key, bool is_table, bool at_root) {
+  if (at_root && is_section(key)) return "expected a section [" + key + "], not a value";
+  const bool section = at_root && is_table;
+  std::string why = section ? "unknown key: there is no section [" + key + "]" : "unknown key";
+  const std::string hint = suggestion(key, section);
+  if (!hint.empty()) why += " (did you mean '" + hint + "'?)";
+  return why;
+}
+
+// ---- reading the document ------------------------------------------------
+
+using Given = std::map<std::string, Value>;
+
+struct Found {
+  std::string key;
+  Value value;
+  std::uint32_t line;
+  std::string error;  // empty for a known key
+};
+
+std::uint32_t line_of(const toml::key& k, const toml::node& n) {
+  return k.source().begin.line > 0 ? k.source().begin.line : n.source().begin.line;
+}
+
+// Every key of the document, in file order; unknown ones carry their error.
+std::vector<Found> flatten(const toml::table& doc, const std::string& source) {
+  std::vector<Found> out;
+  auto add = [&](std::string key, const toml::key& k, const toml::node& n, std::string error) {
+    const std::uint32_t line = line_of(k, n);
+    out.push_back({std::move(key), value_of(n, source + ":" + std::to_string(line)), line,
+                   std::move(error)});
+  };
+  for (auto&& [sk, sn] : doc) {
+    const std::string section(sk.str());
+    const toml::table* table = sn.as_table();
+    if (!table || !is_section(section)) {
+      add(section, sk, sn, unknown_why(section, table != nullptr, true));
+      continue;
+    }
+    for (auto&& [k, n] : *table) {
+      std::string key = section + "." + std::string(k.str());
+      std::string error = find_spec(key) ? "" : unknown_why(key, n.is_table(), false);
+      add(std::move(key), k, n, std::move(error));
+    }
+  }
+  std::stable_sort(out.begin(), out.end(),
+                   [](const Found& a, const Found& b) { return a.line < b.line; });
+  return out;
+}
+
+// "[name]" or "[[name]]" -> name.
+std::string header_name(std::string_view line) {
+  const std::string_view inner = line.substr(0, line.find(']'));
+  const auto b = inner.find_first_not_of('[');
+  return b == std::string_view::npos ? "" : std::string(trim(inner.substr(b)));
+}
+
+// A syntax error names the key on its line, when the line is "name = value".
+std::pair<std::string, std::string> guess_key(std::string_view text, std::uint32_t line) {
+  std::string section, current;
+  std::istringstream in{std::string(text)};
+  std::string l;
+  for (std::uint32_t n = 1; n <= line && std::getline(in, l); ++n) {
+    const std::string_view t = trim(l);
+    if (n == line) current = t;
+    else if (t.starts_with('[')) section = header_name(t);
+  }
+  const auto eq = current.find('=');
+  if (eq == std::string::npos) return {current.empty() ? "(end of file)" : current, ""};
+  const std::string name(trim(std::string_view(current).substr(0, eq)));
+  return {section.empty() ? name : section + "." + name,
+          std::string(trim(std::string_view(current).substr(eq + 1)))};
+}
+
+toml::table parse_toml(std::string_view text, const std::string& source) {
+  try {
+    return toml::parse(text, source);
+  } catch (const toml::parse_error& e) {
+    const std::uint32_t line = e.source().begin.line;
+    const auto [key, value] = guess_key(text, line);
+    throw InputError(key, value, source + ":" + std::to_string(line),
+                     "TOML syntax error: " + std::string(e.description()));
+  }
+}
+
+Given read_document(std::string_view text, const std::string& source) {
+  Given given;
+  for (Found& f : flatten(parse_toml(text, source), source)) {
+    if (!f.error.empty()) throw InputError(f.key, f.value.text, f.value.where, f.error);
+    given[f.key] = std::move(f.value);
+  }
+  return given;
+}
+
+// Override value: TOML syntax, or else the raw text as a string.
+Value override_value(const std::string& raw, const std::string& where) {
+  try {
+    const toml::table t = toml::parse("v = " + raw);
+    if (const toml::node* n = t.get("v"); n && t.size() == 1) {
+      Value v = value_of(*n, where);
+      v.text = raw;
+      return v;
+    }
+  } catch (const toml::parse_error&) {
+  }
+  return {raw, raw, where};
+}
+
+void apply_override(Given& given, const std::string& text) {
+  const std::string where = "--set " + text;
+  const auto eq = text.find('=');
+  if (eq == std::string::npos) throw InputError(text, "", where, "expected section.key=value");
+  const std::string key(trim(std::string_view(text).substr(0, eq)));
+  const std::string raw(trim(std::string_view(text).substr(eq + 1)));
+  if (!find_spec(key)) throw InputError(key, raw, where, unknown_why(key, false, false));
+  // drive.mason and drive.shear_rate are alternatives: an override replaces the file's choice.
+  const char* other = key == "drive.mason" ? "drive.shear_rate"
+                      : key == "drive.shear_rate" ? "drive.mason" : nullptr;
+  if (other && given.count(other) && !given.at(other).where.starts_with("--set")) given.erase(other);
+  given[key] = override_value(raw, where);
+}
+
+void read_values(LoadedScene& s, const Given& given) {
+  for (const KeySpec& spec : k_keys) {
+    const std::string key(spec.key);
+    const auto it = given.find(key);
+    if (it == given.end()) continue;
+    try {
+      assign(s.config, spec, it->second);
+    } catch (const Reject& r) {
+      throw InputError(key, it->second.text, it->second.where, r.why);
+    }
+    s.where[key] = it->second.where;
+  }
+}
+
+bool is_sph(ModelId m) { return m != ModelId::dem_stokes; }
+
+void require_keys(const LoadedScene& s, const Given& given) {
+  for (const KeySpec& spec : k_keys) {
+    const std::string key(spec.key);
+    if (given.count(key)) continue;
+    if (spec.need == Need::required) throw InputError(key, "", s.source, "missing key");
+    if (spec.need == Need::sph_models && is_sph(s.config.model))
+      throw InputError(key, "", s.source,
+                       "missing key (required by model " + std::string(to_string(s.config.model)) + ")");
+  }
+  const auto mason = given.find("drive.mason");
+  const bool rate = given.count("drive.shear_rate") > 0;
+  if (mason == given.end() && !rate)
+    throw InputError("drive.mason", "", s.source, "missing key (give drive.mason or drive.shear_rate)");
+  if (mason != given.end() && rate)
+    throw InputError("drive.mason", mason->second.text, mason->second.where,
+                     "give only one of drive.mason and drive.shear_rate (both given, at " +
+                         given.at("drive.shear_rate").where + ")");
+}
+
+// ---- rules between keys ---------------------------------------------------
+
+using Why = std::optional<std::string>;
+Why unless(bool ok, const std::string& why) { return ok ? Why{} : Why{why}; }
+std::string num(double x) { return format_number(x); }
+double skin_eff(const C& c) { return c.skin > 0 ? c.skin : 0.2 * c.radius; }
+double phi_eff(const C& c) { return c.volume_fraction * c.gap / (c.gap - 4 * c.radius); }
+constexpr double k_max_packing = 0.35;  // random sequential addition jams near 0.38
+
+struct Rule {
+  std::string_view key;                          // the key blamed
+  Why (*check)(const C& c, const Given& given);  // a reason when the value is impossible
+};
+
+// Single-key ranges passed already (k_keys); a rule may assume the rules above it passed.
+const Rule k_rules[] = {
+    {"box.gap", [](const C& c, const Given&) {
+       return unless(c.gap > 4 * c.radius, "must be > 4*radius = " + num(4 * c.radius) +
+                                               " m (free centres stay 2*radius from each wall)");
+     }},
+    {"particles.volume_fraction", [](const C& c, const Given&) {
+       return unless(phi_eff(c) <= k_max_packing,
+                     "cannot be packed: effective fraction volume_fraction*gap/(gap - 4*radius) = " +
+                         num(phi_eff(c)) + " (limit " + num(k_max_packing) + ")");
+     }},
+    {"particles.magnetization", [](const C& c, const Given& g) {
+       return unless(c.magnetization > 0 || !g.count("drive.mason"),
+                     "must be > 0 when drive.mason is given");
+     }},
+    {"particles.dipole_cutoff", [](const C& c, const Given&) {
+       return unless(c.dipole_cutoff >= 2 * c.radius,
+                     "must be >= 2*radius = " + num(2 * c.radius) + " m");
+     }},
+    {"particles.dipole_cutoff", [](const C& c, const Given&) {
+       const double half = std::min(c.ly, c.lz) / 2;
+       return unless(c.dipole_cutoff + skin_eff(c) <= half,
+                     "dipole_cutoff + skin = " + num(c.dipole_cutoff + skin_eff(c)) +
+                         " m exceeds min(box.ly, box.lz)/2 = " + num(half) + " m (minimum image)");
+     }},
+    {"walls.spacing", [](const C& c, const Given&) {
+       return unless(c.wall_spacing <= 2 * c.radius,
+                     "must be <= 2*radius = " + num(2 * c.radius) + " m");
+     }},
+    {"drive.warmup_strain", [](const C& c, const Given&) {
+       return unless(c.warmup_strain < c.strain, "must be < drive.strain = " + num(c.strain));
+     }},
+};
+
+void validate(const LoadedScene& s, const Given& given) {
+  for (const Rule& r : k_rules) {
+    const Why why = r.check(s.config, given);
+    if (!why) continue;
+    const std::string key(r.key);
+    const auto it = given.find(key);
+    throw InputError(key, it == given.end() ? "" : it->second.text, s.locate(key), *why);
+  }
+}
+
+void fill_drive(C& c, const Given& given) {
+  if (given.count("drive.mason"))
+    c.shear_rate = shear_rate_from_mason(c.mason, c.viscosity, c.magnetization);
+  else
+    c.mason = mason_from_shear_rate(c.shear_rate, c.viscosity, c.magnetization);
+}
+
+}  // namespace
+
+std::string LoadedScene::locate(const std::string& key) const {
+  const auto it = where.find(key);
+  return it == where.end() ? source : it->second;
+}
+
+LoadedScene parse_scene(std::string_view toml_text, const std::string& source_name,
+                        const std::vector<std::string>& overrides) {
+  Given given = read_document(toml_text, source_name);
+  for (const std::string& o : overrides) apply_override(given, o);
+  LoadedScene s;
+  s.source = source_name;
+  read_values(s, given);
+  require_keys(s, given);
+  validate(s, given);
+  fill_drive(s.config, given);
+  return s;
+}
+
+LoadedScene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw InputError("scene file", path, "", "no such file");
+  if (fs::is_directory(path, ec)) throw InputError("scene file", path, "", "is a directory");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError("scene file", path, "", "cannot be read");
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  return parse_scene(text, path, overrides);
+}
+
+}  // namespace mrf

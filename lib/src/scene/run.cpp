@@ -1,0 +1,203 @@
+#include "mrf/scene/run.hpp"
+
+#include <omp.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "mrf/error.hpp"
+#include "mrf/forces/drag.hpp"
+#include "mrf/observe/block_average.hpp"
+#include "mrf/observe/stress.hpp"
+#include "mrf/scene/dem_model.hpp"
+
+namespace mrf {
+
+TimeStepChoice choose_time_step(const LoadedScene& scene, const DemParams& p) {
+  const SceneConfig& c = scene.config;
+  auto ve = dem_limits(p, c, IntegratorId::verlet_exp);
+  auto od = dem_limits(p, c, IntegratorId::overdamped);
+  TimeStepChoice t{};
+  switch (c.integrator) {
+    case IntegratorId::verlet_exp: t.scheme = IntegratorId::verlet_exp; break;
+    case IntegratorId::overdamped: t.scheme = IntegratorId::overdamped; break;
+    case IntegratorId::automatic:
+      t.scheme = smallest(ve) >= smallest(od) ? IntegratorId::verlet_exp : IntegratorId::overdamped;
+      break;
+    case IntegratorId::implicit:
+      throw InputError("numerics.integrator", "implicit", scene.locate("numerics.integrator"),
+                       "the implicit integrator is not implemented yet (issue #7)");
+  }
+  t.limits = t.scheme == IntegratorId::verlet_exp ? ve : od;
+  t.other = t.scheme == IntegratorId::verlet_exp ? od : ve;
+  const StabilityLimit& b = binding(t.limits);
+  if (c.dt) {
+    if (*c.dt > b.dt) {
+      std::ostringstream why;
+      why << "above the stability limit " << b.dt << " s of the " << to_string(t.scheme)
+          << " integrator, set by '" << b.name << "' (" << b.basis << ")";
+      throw InputError("numerics.dt", std::to_string(*c.dt), scene.locate("numerics.dt"), why.str());
+    }
+    t.dt = *c.dt;
+  } else {
+    t.dt = c.dt_safety * b.dt;
+  }
+  return t;
+}
+
+namespace {
+
+void print_limits(const TimeStepChoice& t, const RunSummary& s) {
+  std::fprintf(stderr, "mrf: %s, Mn = %.4g (9 eta gdot / 2 mu0 M^2), gdot = %.4g 1/s\n",
+               s.model.c_str(), s.mason, s.shear_rate);
+  auto table = [](const char* scheme, const std::vector<StabilityLimit>& l) {
+    for (const auto& x : l)
+      std::fprintf(stderr, "  %-11s %-20s dt < %-10.3g  %s\n", scheme, x.name.c_str(), x.dt, x.basis.c_str());
+  };
+  table(to_string(t.scheme), t.limits);
+  table(to_string(t.scheme == IntegratorId::verlet_exp ? IntegratorId::overdamped : IntegratorId::verlet_exp),
+        t.other);
+  std::fprintf(stderr, "  chosen: %s, dt = %.4g s (bound by '%s'), %ld steps; St = %.3g, Re_p = %.3g\n",
+               to_string(t.scheme), t.dt, binding(t.limits).name.c_str(), s.steps, s.stokes_number,
+               s.reynolds_number);
+}
+
+// Running sums of one time-series row.
+struct Row {
+  double tau_p = 0, vir_mag = 0, vir_con = 0, max_overlap = 0, e_dip = 0, e_hertz = 0;
+  int n = 0;
+  void add(const PairSums& p, const Box& box) {
+    tau_p += wall_shear_stress(p.wall_fz, box);
+    vir_mag += virial_shear_stress(p.virial_mag_xz, box);
+    vir_con += virial_shear_stress(p.virial_con_xz, box);
+    max_overlap = std::max(max_overlap, p.max_overlap);
+    e_dip += p.energy_dipole;
+    e_hertz += p.energy_hertz;
+    ++n;
+  }
+};
+
+struct Series {
+  std::vector<double> total, particles, virial, mag, con, diff;
+};
+
+Measurement measure(const std::vector<double>& v) {
+  const BlockAverage b = block_average(v);
+  return {b.mean, b.sem, b.drift_z};
+}
+
+void write_frame(std::ofstream& out, const ShearCell& cell, double radius, double time) {
+  out << cell.free.size() + cell.walls.size() << "\n";
+  out << "Lattice=\"" << cell.box.gap + 2 * radius << " 0 0 0 " << cell.box.ly << " 0 0 0 "
+      << cell.box.lz << "\" Origin=\"" << -0.5 * cell.box.gap - radius
+      << " 0 0\" Properties=species:S:1:pos:R:3:radius:R:1 Time=" << time << "\n";
+  for (const auto& x : cell.free.x) out << "Fe " << x.x() << " " << x.y() << " " << x.z() << " " << radius << "\n";
+  for (const auto& x : cell.walls.x) out << "W " << x.x() << " " << x.y() << " " << x.z() << " " << radius << "\n";
+}
+
+}  // namespace
+
+RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
+  const SceneConfig& c = scene.config;
+  if (c.model != ModelId::dem_stokes)
+    throw InputError("scene.model", to_string(c.model), scene.locate("scene.model"),
+                     "the coupled DEM-SPH models are not implemented yet (issue #5)");
+  if (c.threads > 0) omp_set_num_threads(c.threads);
+  const DemParams p = dem_params(c);
+  const TimeStepChoice ts = choose_time_step(scene, p);
+  ShearCell cell = build_shear_cell(c, scene.locate("particles.volume_fraction"));
+  for (std::size_t i = 0; i < cell.free.size(); ++i) cell.free.v[i] = couette_velocity(cell.free.x[i], c.shear_rate);
+
+  RunSummary s;
+  s.model = to_string(c.model);
+  s.integrator = to_string(ts.scheme);
+  s.binding_limit = binding(ts.limits).name;
+  s.mason = c.mason;
+  s.shear_rate = c.shear_rate;
+  s.strain = c.strain;
+  s.warmup_strain = c.warmup_strain;
+  s.dt = ts.dt;
+  s.steps = static_cast<long>(std::ceil(c.strain / (c.shear_rate * ts.dt)));
+  s.n_particles = static_cast<long>(cell.free.size());
+  s.n_wall = static_cast<long>(cell.walls.size());
+  s.stokes_number = stokes_number(p);
+  s.reynolds_number = particle_reynolds(c);
+  s.stress_fluid = imposed_fluid_stress(c.viscosity, c.shear_rate);
+  s.youngs_modulus = c.youngs_modulus;
+  s.density = c.density;
+  s.magnetization = c.magnetization;
+  s.volume_fraction = c.volume_fraction;
+  s.seed = c.seed;
+  s.threads = omp_get_max_threads();
+  if (!opt.quiet) print_limits(ts, s);
+
+  DemModel model(std::move(cell), p, ts.scheme, ts.dt);
+  const long every = c.every > 0 ? c.every : std::max(1L, s.steps / 2000);
+  const long frame_every = c.frames > 0 ? std::max(1L, s.steps / c.frames) : 0;
+  std::ofstream ts_out, frames_out;
+  if (!opt.out_dir.empty()) {
+    std::filesystem::create_directories(opt.out_dir);
+    ts_out.open(opt.out_dir + "/timeseries.csv");
+    ts_out << "time_s,strain,stress_total_Pa,stress_particles_Pa,stress_fluid_Pa,"
+              "stress_virial_magnetic_Pa,stress_virial_contact_Pa,max_overlap_over_radius,"
+              "energy_dipole_J,energy_hertz_J\n";
+    if (frame_every > 0) frames_out.open(opt.out_dir + "/frames.xyz");
+  }
+  Series se;
+  Row row;
+  double max_overlap = 0;
+  long pair_evals = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  auto last_report = t0;
+  for (long n = 1; n <= s.steps; ++n) {
+    model.step();
+    row.add(model.sums(), model.cell().box);
+    pair_evals += model.sums().pair_evaluations;
+    if (frame_every > 0 && n % frame_every == 0 && frames_out) write_frame(frames_out, model.cell(), p.radius, model.time());
+    if (n % every != 0 && n != s.steps) continue;
+    const double k = 1.0 / row.n, strain = model.time() * c.shear_rate;
+    const double tp = row.tau_p * k, vm = row.vir_mag * k, vc = row.vir_con * k;
+    max_overlap = std::max(max_overlap, row.max_overlap);
+    if (ts_out)
+      ts_out << model.time() << "," << strain << "," << tp + s.stress_fluid << "," << tp << ","
+             << s.stress_fluid << "," << vm << "," << vc << "," << row.max_overlap / p.radius << ","
+             << row.e_dip * k << "," << row.e_hertz * k << "\n";
+    if (strain > c.warmup_strain) {
+      se.total.push_back(tp + s.stress_fluid);
+      se.particles.push_back(tp);
+      se.virial.push_back(vm + vc);
+      se.mag.push_back(vm);
+      se.con.push_back(vc);
+      se.diff.push_back(tp - vm - vc);
+    }
+    row = Row{};
+    const auto now = std::chrono::steady_clock::now();
+    if (!opt.quiet && std::chrono::duration<double>(now - last_report).count() > 2.0) {
+      last_report = now;
+      const double el = std::chrono::duration<double>(now - t0).count();
+      std::fprintf(stderr, "\r  strain %.3f / %.3f  %.3g steps/s  ETA %.0f s   ", strain, c.strain,
+                   static_cast<double>(n) / el,
+                   el * static_cast<double>(s.steps - n) / static_cast<double>(n));
+    }
+  }
+  s.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (!opt.quiet) std::fprintf(stderr, "\r  done: %ld steps in %.1f s%30s\n", s.steps, s.wall_seconds, "");
+  s.stress_total = measure(se.total);
+  s.stress_particles = measure(se.particles);
+  s.stress_virial = measure(se.virial);
+  s.stress_virial_magnetic = measure(se.mag);
+  s.stress_virial_contact = measure(se.con);
+  s.wall_minus_virial = measure(se.diff);
+  s.max_overlap_over_radius = max_overlap / p.radius;
+  s.neighbor_builds = model.lists().builds;
+  s.particle_steps_per_second = static_cast<double>(s.n_particles * s.steps) / s.wall_seconds;
+  s.pair_evaluations_per_second = static_cast<double>(pair_evals) / s.wall_seconds;
+  if (!opt.out_dir.empty()) std::ofstream(opt.out_dir + "/summary.json") << summary_json(s) << "\n";
+  return s;
+}
+
+}  // namespace mrf
