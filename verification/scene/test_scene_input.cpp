@@ -123,7 +123,8 @@ TEST(SceneInput, MasonAndShearRateFollowTheClosedForm) {
   const double eta = 0.1, m = 1e6;
   const SceneConfig c = parse_scene(k_scene, "scene.toml").config;
   EXPECT_DOUBLE_EQ(9 * eta * c.shear_rate / (2 * k_mu0 * m * m), 0.01);
-  const SceneConfig r = parse_scene(edit(k_scene, "mason =", "shear_rate = \"30 1/s\""), "s").config;
+  const std::string by_rate = edit(k_scene, "mason =", "shear_rate = \"30 1/s\"");
+  const SceneConfig r = parse_scene(by_rate, "s").config;
   EXPECT_DOUBLE_EQ(r.shear_rate, 30);
   EXPECT_DOUBLE_EQ(r.mason, 9 * eta * 30 / (2 * k_mu0 * m * m));
 }

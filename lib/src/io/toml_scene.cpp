@@ -9,6 +9,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -32,33 +33,27 @@ struct Unit {
   double factor;          // to SI
 };
 
-// The first unit of each dimension is the SI unit of a plain number.
 constexpr Unit k_units[] = {
-    {Dim::length, "m", 1},          {Dim::length, "mm", 1e-3},       {Dim::length, "um", 1e-6},
-    {Dim::length, "nm", 1e-9},      {Dim::time, "s", 1},             {Dim::time, "ms", 1e-3},
-    {Dim::time, "us", 1e-6},        {Dim::time, "ns", 1e-9},         {Dim::pressure, "Pa", 1},
-    {Dim::pressure, "kPa", 1e3},    {Dim::pressure, "MPa", 1e6},     {Dim::pressure, "GPa", 1e9},
-    {Dim::viscosity, "Pa s", 1},    {Dim::viscosity, "Pa*s", 1},     {Dim::viscosity, "mPa s", 1e-3},
-    {Dim::viscosity, "mPa*s", 1e-3}, {Dim::density, "kg/m^3", 1},    {Dim::density, "kg/m3", 1},
-    {Dim::density, "g/cm^3", 1e3},  {Dim::density, "g/cm3", 1e3},    {Dim::magnetization, "A/m", 1},
-    {Dim::magnetization, "kA/m", 1e3}, {Dim::magnetization, "MA/m", 1e6}, {Dim::rate, "1/s", 1},
-    {Dim::rate, "s^-1", 1},         {Dim::velocity, "m/s", 1},
+    {Dim::length, "m", 1}, {Dim::length, "mm", 1e-3}, {Dim::length, "um", 1e-6},
+    {Dim::length, "nm", 1e-9},
+    {Dim::time, "s", 1}, {Dim::time, "ms", 1e-3}, {Dim::time, "us", 1e-6}, {Dim::time, "ns", 1e-9},
+    {Dim::pressure, "Pa", 1}, {Dim::pressure, "kPa", 1e3}, {Dim::pressure, "MPa", 1e6},
+    {Dim::pressure, "GPa", 1e9},
+    {Dim::viscosity, "Pa s", 1}, {Dim::viscosity, "Pa*s", 1}, {Dim::viscosity, "mPa s", 1e-3},
+    {Dim::viscosity, "mPa*s", 1e-3},
+    {Dim::density, "kg/m^3", 1}, {Dim::density, "kg/m3", 1}, {Dim::density, "g/cm^3", 1e3},
+    {Dim::density, "g/cm3", 1e3},
+    {Dim::magnetization, "A/m", 1}, {Dim::magnetization, "kA/m", 1e3},
+    {Dim::magnetization, "MA/m", 1e6},
+    {Dim::rate, "1/s", 1}, {Dim::rate, "s^-1", 1},
+    {Dim::velocity, "m/s", 1},
 };
 
-std::string_view noun(Dim d) {
-  switch (d) {
-    case Dim::none: return "a dimensionless number";
-    case Dim::length: return "a length";
-    case Dim::time: return "a time";
-    case Dim::pressure: return "a pressure";
-    case Dim::viscosity: return "a viscosity";
-    case Dim::density: return "a density";
-    case Dim::magnetization: return "a magnetization";
-    case Dim::rate: return "a rate";
-    case Dim::velocity: return "a velocity";
-  }
-  return "?";
-}
+// Indexed by Dim.
+constexpr std::string_view k_nouns[] = {"a dimensionless number", "a length", "a time",
+                                        "a pressure", "a viscosity", "a density",
+                                        "a magnetization", "a rate", "a velocity"};
+std::string_view noun(Dim d) { return k_nouns[static_cast<std::size_t>(d)]; }
 
 std::string unit_list(Dim d) {
   std::string s;
@@ -132,6 +127,14 @@ Value value_of(const toml::node& n, std::string where) {
   return out;
 }
 
+// What a number of this dimension may look like, for messages.
+std::string expects(Dim dim) {
+  if (dim == Dim::none) return "expected a plain number";
+  const std::string units = unit_list(dim);
+  return "expected a number in " + units.substr(0, units.find(',')) +
+         " or a string \"<number> <unit>\" (units " + units + ")";
+}
+
 // "<number> <unit>" or "<number>" -> SI value.
 double parse_quantity(const std::string& s, Dim dim) {
   std::string_view t = trim(s);
@@ -139,7 +142,7 @@ double parse_quantity(const std::string& s, Dim dim) {
   double x = 0;
   const auto r = std::from_chars(t.data(), t.data() + t.size(), x);
   if (r.ec == std::errc::result_out_of_range) throw Reject{"number out of range"};
-  if (r.ec != std::errc()) throw Reject{"expected a number, or a string like \"2.5 um\""};
+  if (r.ec != std::errc()) throw Reject{expects(dim)};
   if (!std::isfinite(x)) throw Reject{"not a finite number"};
   const std::string written(trim(std::string_view(r.ptr, t.data() + t.size() - r.ptr)));
   const std::string unit = normalize_unit(written);
@@ -164,8 +167,7 @@ double read_number(const Value& val, Dim dim) {
     return *d;
   }
   if (const auto* s = std::get_if<std::string>(&val.v)) return parse_quantity(*s, dim);
-  throw Reject{dim == Dim::none ? "expected a number"
-                                : "expected a number (SI) or a string like \"2.5 um\""};
+  throw Reject{expects(dim)};
 }
 
 template <class Int>
@@ -232,7 +234,8 @@ const KeySpec k_keys[] = {
     {"box.ly", &C::ly, Dim::length, Need::required, k_pos},
     {"box.lz", &C::lz, Dim::length, Need::required, k_pos},
     {"particles.radius", &C::radius, Dim::length, Need::required, k_pos},
-    {"particles.volume_fraction", &C::volume_fraction, Dim::none, Need::required, {0, 1, false, true}},
+    {"particles.volume_fraction", &C::volume_fraction, Dim::none, Need::required,
+     {0, 1, false, true}},
     {"particles.density", &C::density, Dim::density, Need::required, k_pos},
     {"particles.magnetization", &C::magnetization, Dim::magnetization, Need::required, k_nonneg},
     {"particles.dipole_cutoff", &C::dipole_cutoff, Dim::length, Need::required, k_pos},
@@ -278,9 +281,10 @@ void assign(SceneConfig& c, const KeySpec& spec, const Value& val) {
                  [&](std::uint64_t C::*m) { c.*m = read_count<std::uint64_t>(val); },
                  [&](ModelId C::*m) { c.*m = read_choice(val, k_models); },
                  [&](IntegratorId C::*m) { c.*m = read_choice(val, k_integrators); },
-                 [&](std::optional<double> C::*m) {
+                 [&](std::optional<double> C::*m) {  // "auto" or a number
                    const auto* s = std::get_if<std::string>(&val.v);
-                   c.*m = s && trim(*s) == "auto" ? std::optional<double>{} : read_in_range(val, spec);
+                   c.*m = s && trim(*s) == "auto" ? std::nullopt
+                                                  : std::optional(read_in_range(val, spec));
                  },
              },
              spec.target);
@@ -336,7 +340,7 @@ std::string suggestion(std::string_view wrong, bool want_section) {
 }
 
 std::string unknown_why(const std::string& key, bool is_table, bool at_root) {
-  if (at_root && is_section(key)) return "expected a section [" + key + "], not a value";
+  if (at_root && is_section(key)) return "expected one section [" + key + "]";
   const bool section = at_root && is_table;
   std::string why = section ? "unknown key: there is no section [" + key + "]" : "unknown key";
   const std::string hint = suggestion(key, section);
@@ -453,7 +457,8 @@ void apply_override(Given& given, const std::string& text) {
   // drive.mason and drive.shear_rate are alternatives: an override replaces the file's choice.
   const char* other = key == "drive.mason" ? "drive.shear_rate"
                       : key == "drive.shear_rate" ? "drive.mason" : nullptr;
-  if (other && given.count(other) && !given.at(other).where.starts_with("--set")) given.erase(other);
+  const auto clash = other ? given.find(other) : given.end();
+  if (clash != given.end() && !clash->second.where.starts_with("--set")) given.erase(clash);
   given[key] = override_value(raw, where);
 }
 
@@ -480,12 +485,14 @@ void require_keys(const LoadedScene& s, const Given& given) {
     if (spec.need == Need::required) throw InputError(key, "", s.source, "missing key");
     if (spec.need == Need::sph_models && is_sph(s.config.model))
       throw InputError(key, "", s.source,
-                       "missing key (required by model " + std::string(to_string(s.config.model)) + ")");
+                       "missing key (required by model " + std::string(to_string(s.config.model)) +
+                           ")");
   }
   const auto mason = given.find("drive.mason");
   const bool rate = given.count("drive.shear_rate") > 0;
   if (mason == given.end() && !rate)
-    throw InputError("drive.mason", "", s.source, "missing key (give drive.mason or drive.shear_rate)");
+    throw InputError("drive.mason", "", s.source,
+                     "missing key (give drive.mason or drive.shear_rate)");
   if (mason != given.end() && rate)
     throw InputError("drive.mason", mason->second.text, mason->second.where,
                      "give only one of drive.mason and drive.shear_rate (both given, at " +
@@ -496,7 +503,12 @@ void require_keys(const LoadedScene& s, const Given& given) {
 
 using Why = std::optional<std::string>;
 Why unless(bool ok, const std::string& why) { return ok ? Why{} : Why{why}; }
-std::string num(double x) { return format_number(x); }
+// Derived numbers in messages: 6 significant digits are enough to act on.
+std::string num(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", x);
+  return buf;
+}
 double skin_eff(const C& c) { return c.skin > 0 ? c.skin : 0.2 * c.radius; }
 double phi_eff(const C& c) { return c.volume_fraction * c.gap / (c.gap - 4 * c.radius); }
 constexpr double k_max_packing = 0.35;  // random sequential addition jams near 0.38
@@ -514,8 +526,8 @@ const Rule k_rules[] = {
      }},
     {"particles.volume_fraction", [](const C& c, const Given&) {
        return unless(phi_eff(c) <= k_max_packing,
-                     "cannot be packed: effective fraction volume_fraction*gap/(gap - 4*radius) = " +
-                         num(phi_eff(c)) + " (limit " + num(k_max_packing) + ")");
+                     "cannot be packed: effective fraction volume_fraction*gap/(gap - 4*radius)"
+                     " = " + num(phi_eff(c)) + " (limit " + num(k_max_packing) + ")");
      }},
     {"particles.magnetization", [](const C& c, const Given& g) {
        return unless(c.magnetization > 0 || !g.count("drive.mason"),
