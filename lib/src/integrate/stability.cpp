@@ -60,10 +60,6 @@ double verlet_exp_oscillator_limit(double omega, double tau) {
 
 double overdamped_contact_limit(double gamma, double k_eff) { return gamma / k_eff; }
 
-double contact_stiffness_at_load(double hertz_k, double load) {
-  return hertz_local_stiffness(hertz_overlap_under_load(load, hertz_k), hertz_k);
-}
-
 namespace {
 // A free pair in contact: relative coordinate with reduced mass m/2 and the
 // same relaxation time, so omega^2 = 2 k_eff / m.
@@ -78,14 +74,20 @@ double contact_limit_at_overlap(const DemParams& p, IntegratorId scheme, double 
   return k_eff > 0 ? contact_limit(p, scheme, k_eff) : std::numeric_limits<double>::infinity();
 }
 
+double expected_overlap(const DemParams& p, IntegratorId scheme) {
+  const double h_load = hertz_overlap_under_load(p.expected_load, p.hertz_k);
+  if (scheme == IntegratorId::overdamped) return h_load;  // no inertia: overlap follows the load
+  return std::max(h_load, hertz_max_overlap(0.5 * p.mass, p.impact_speed, p.hertz_k));
+}
+
 std::vector<StabilityLimit> dem_limits(const DemParams& p, const SceneConfig& c, IntegratorId scheme) {
   constexpr double inf = std::numeric_limits<double>::infinity();
   std::vector<StabilityLimit> out;
-  const double k_eff = contact_stiffness_at_load(p.hertz_k, p.expected_load);
-  const double h = hertz_overlap_under_load(p.expected_load, p.hertz_k);
-  out.push_back({"hertz contact", contact_limit(p, scheme, k_eff),
-                 "expected load " + fmt(p.expected_load) + " N, overlap/R " +
-                     fmt(h / p.radius)});
+  const double h = expected_overlap(p, scheme);
+  out.push_back({"hertz contact", contact_limit_at_overlap(p, scheme, h),
+                 "expected overlap/R " + fmt(h / p.radius) + " (load " + fmt(p.expected_load) +
+                     " N" + (scheme == IntegratorId::overdamped ? "" : ", impact at " + fmt(p.impact_speed) + " m/s") +
+                     ")"});
   out.push_back({"drag relaxation", inf,
                  "tau_p = " + fmt(p.tau_p) +
                      (scheme == IntegratorId::overdamped ? " s (inertia neglected)"

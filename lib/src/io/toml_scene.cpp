@@ -1,109 +1,28 @@
 // Scene file loader. One table of key specs (k_keys) drives reading, defaults
 // and missing-key checks; one table of rules (k_rules) drives validation.
-// Quantities are plain numbers (SI) or strings "<number> <unit>" (k_units).
+// Quantities (numbers with units, ranges) are read by io/quantity.
 #include "mrf/io/toml_scene.hpp"
 
 #include <toml++/toml.h>
 
 #include <algorithm>
-#include <charconv>
-#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <limits>
 #include <optional>
 #include <sstream>
-#include <variant>
 
 #include "mrf/error.hpp"
+#include "mrf/io/quantity.hpp"
 
 namespace mrf {
 namespace {
 
-// ---- units ---------------------------------------------------------------
-
-enum class Dim { none, length, time, pressure, viscosity, density, magnetization, rate, velocity };
-
-struct Unit {
-  Dim dim;
-  std::string_view name;  // after normalize_unit
-  double factor;          // to SI
-};
-
-constexpr Unit k_units[] = {
-    {Dim::length, "m", 1}, {Dim::length, "mm", 1e-3}, {Dim::length, "um", 1e-6},
-    {Dim::length, "nm", 1e-9},
-    {Dim::time, "s", 1}, {Dim::time, "ms", 1e-3}, {Dim::time, "us", 1e-6}, {Dim::time, "ns", 1e-9},
-    {Dim::pressure, "Pa", 1}, {Dim::pressure, "kPa", 1e3}, {Dim::pressure, "MPa", 1e6},
-    {Dim::pressure, "GPa", 1e9},
-    {Dim::viscosity, "Pa s", 1}, {Dim::viscosity, "Pa*s", 1}, {Dim::viscosity, "mPa s", 1e-3},
-    {Dim::viscosity, "mPa*s", 1e-3},
-    {Dim::density, "kg/m^3", 1}, {Dim::density, "kg/m3", 1}, {Dim::density, "g/cm^3", 1e3},
-    {Dim::density, "g/cm3", 1e3},
-    {Dim::magnetization, "A/m", 1}, {Dim::magnetization, "kA/m", 1e3},
-    {Dim::magnetization, "MA/m", 1e6},
-    {Dim::rate, "1/s", 1}, {Dim::rate, "s^-1", 1},
-    {Dim::velocity, "m/s", 1},
-};
-
-// Indexed by Dim.
-constexpr std::string_view k_nouns[] = {"a dimensionless number", "a length", "a time",
-                                        "a pressure", "a viscosity", "a density",
-                                        "a magnetization", "a rate", "a velocity"};
-std::string_view noun(Dim d) { return k_nouns[static_cast<std::size_t>(d)]; }
-
-std::string unit_list(Dim d) {
-  std::string s;
-  for (const Unit& u : k_units)
-    if (u.dim == d) s += (s.empty() ? "" : ", ") + std::string(u.name);
-  return s;
-}
-
-std::string_view trim(std::string_view s) {
-  const auto b = s.find_first_not_of(" \t\r\n");
-  if (b == std::string_view::npos) return {};
-  return s.substr(b, s.find_last_not_of(" \t\r\n") - b + 1);
-}
-
-// Micro sign (U+00B5) and Greek mu (U+03BC) become 'u'; runs of blanks one space.
-std::string normalize_unit(std::string_view u) {
-  std::string s;
-  for (std::size_t i = 0; i < u.size(); ++i) {
-    const std::string_view rest = u.substr(i);
-    if (rest.starts_with("\u00b5") || rest.starts_with("\u03bc")) {
-      s += 'u';
-      ++i;  // both are two bytes in UTF-8
-    } else if (u[i] == ' ' || u[i] == '\t') {
-      if (s.empty() || s.back() != ' ') s += ' ';
-    } else {
-      s += u[i];
-    }
-  }
-  return s;
-}
-
 // ---- values as written ---------------------------------------------------
 
-// One value from the file or an override, before conversion.
-struct Value {
-  std::variant<std::monostate, std::int64_t, double, bool, std::string> v;  // monostate: array...
-  std::string text;   // as shown in messages
-  std::string where;  // "FILE:LINE" or "--set key=value"
-};
-
-// Thrown by the readers; the caller adds key, value and location.
-struct Reject {
-  std::string why;
-};
-
-std::string format_number(double x) {
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof buf, x);
-  return std::string(buf, r.ptr);
-}
+using Value = WrittenValue;
 
 Value value_of(const toml::node& n, std::string where) {
   Value out{std::monostate{}, "", std::move(where)};
@@ -127,59 +46,6 @@ Value value_of(const toml::node& n, std::string where) {
   return out;
 }
 
-// What a number of this dimension may look like, for messages.
-std::string expects(Dim dim) {
-  if (dim == Dim::none) return "expected a plain number";
-  const std::string units = unit_list(dim);
-  return "expected a number in " + units.substr(0, units.find(',')) +
-         " or a string \"<number> <unit>\" (units " + units + ")";
-}
-
-// "<number> <unit>" or "<number>" -> SI value.
-double parse_quantity(const std::string& s, Dim dim) {
-  std::string_view t = trim(s);
-  if (t.starts_with('+')) t.remove_prefix(1);
-  double x = 0;
-  const auto r = std::from_chars(t.data(), t.data() + t.size(), x);
-  if (r.ec == std::errc::result_out_of_range) throw Reject{"number out of range"};
-  if (r.ec != std::errc()) throw Reject{expects(dim)};
-  if (!std::isfinite(x)) throw Reject{"not a finite number"};
-  const std::string written(trim(std::string_view(r.ptr, t.data() + t.size() - r.ptr)));
-  const std::string unit = normalize_unit(written);
-  if (dim == Dim::none) {
-    if (!unit.empty()) throw Reject{"a dimensionless number takes no unit (got '" + written + "')"};
-    return x;
-  }
-  const std::string expected = std::string(noun(dim)) + " (expected " + unit_list(dim);
-  if (unit.empty()) throw Reject{"missing unit for " + expected + ")"};
-  for (const Unit& u : k_units) {
-    if (u.name != unit) continue;
-    if (u.dim != dim) throw Reject{"wrong unit '" + written + "' for " + expected + ")"};
-    return x * u.factor;
-  }
-  throw Reject{"unknown unit '" + written + "' for " + expected + ")"};
-}
-
-double read_number(const Value& val, Dim dim) {
-  if (const auto* i = std::get_if<std::int64_t>(&val.v)) return static_cast<double>(*i);
-  if (const auto* d = std::get_if<double>(&val.v)) {
-    if (!std::isfinite(*d)) throw Reject{"not a finite number"};
-    return *d;
-  }
-  if (const auto* s = std::get_if<std::string>(&val.v)) return parse_quantity(*s, dim);
-  throw Reject{expects(dim)};
-}
-
-template <class Int>
-Int read_count(const Value& val) {
-  const auto* i = std::get_if<std::int64_t>(&val.v);
-  if (!i) throw Reject{"expected an integer"};
-  if (*i < 0) throw Reject{"must be an integer >= 0"};
-  if (static_cast<std::uint64_t>(*i) > static_cast<std::uint64_t>(std::numeric_limits<Int>::max()))
-    throw Reject{"integer too large"};
-  return static_cast<Int>(*i);
-}
-
 template <class E, std::size_t N>
 E read_choice(const Value& val, const E (&all)[N]) {
   if (const auto* s = std::get_if<std::string>(&val.v))
@@ -187,32 +53,12 @@ E read_choice(const Value& val, const E (&all)[N]) {
       if (*s == to_string(e)) return e;
   std::string list;
   for (E e : all) list += (list.empty() ? "" : ", ") + std::string(to_string(e));
-  throw Reject{"expected one of: " + list};
+  throw ValueError("expected one of: " + list);
 }
 
 // ---- the key table -------------------------------------------------------
 
 enum class Need { required, optional, sph_models, one_of_drive };
-
-// Allowed interval of a number (open ends are strict), checked as it is read.
-struct Range {
-  double lo, hi;
-  bool lo_open, hi_open;
-};
-constexpr double k_inf = std::numeric_limits<double>::infinity();
-constexpr Range k_any{-k_inf, k_inf, false, false};
-constexpr Range k_pos{0, k_inf, true, false};
-constexpr Range k_nonneg{0, k_inf, false, false};
-
-bool inside(double x, const Range& r) {
-  return (r.lo_open ? x > r.lo : x >= r.lo) && (r.hi_open ? x < r.hi : x <= r.hi);
-}
-
-std::string describe(const Range& r) {
-  if (r.hi == k_inf) return (r.lo_open ? "must be > " : "must be >= ") + format_number(r.lo);
-  return std::string("must be in ") + (r.lo_open ? "(" : "[") + format_number(r.lo) + ", " +
-         format_number(r.hi) + (r.hi_open ? ")" : "]");
-}
 
 using Target = std::variant<double SceneConfig::*, int SceneConfig::*, std::uint64_t SceneConfig::*,
                             ModelId SceneConfig::*, IntegratorId SceneConfig::*,
@@ -263,12 +109,6 @@ constexpr ModelId k_models[] = {ModelId::dem_stokes, ModelId::demsph_stokes, Mod
 constexpr IntegratorId k_integrators[] = {IntegratorId::automatic, IntegratorId::verlet_exp,
                                           IntegratorId::overdamped, IntegratorId::implicit};
 
-double read_in_range(const Value& val, const KeySpec& spec) {
-  const double x = read_number(val, spec.dim);
-  if (!inside(x, spec.range)) throw Reject{describe(spec.range)};
-  return x;
-}
-
 template <class... F>
 struct Overloaded : F... {
   using F::operator()...;
@@ -276,15 +116,15 @@ struct Overloaded : F... {
 
 void assign(SceneConfig& c, const KeySpec& spec, const Value& val) {
   std::visit(Overloaded{
-                 [&](double C::*m) { c.*m = read_in_range(val, spec); },
+                 [&](double C::*m) { c.*m = read_number(val, spec.dim, spec.range); },
                  [&](int C::*m) { c.*m = read_count<int>(val); },
                  [&](std::uint64_t C::*m) { c.*m = read_count<std::uint64_t>(val); },
                  [&](ModelId C::*m) { c.*m = read_choice(val, k_models); },
                  [&](IntegratorId C::*m) { c.*m = read_choice(val, k_integrators); },
                  [&](std::optional<double> C::*m) {  // "auto" or a number
                    const auto* s = std::get_if<std::string>(&val.v);
-                   c.*m = s && trim(*s) == "auto" ? std::nullopt
-                                                  : std::optional(read_in_range(val, spec));
+                   if (s && trim(*s) == "auto") c.*m = std::nullopt;
+                   else c.*m = read_number(val, spec.dim, spec.range);
                  },
              },
              spec.target);
@@ -469,8 +309,8 @@ void read_values(LoadedScene& s, const Given& given) {
     if (it == given.end()) continue;
     try {
       assign(s.config, spec, it->second);
-    } catch (const Reject& r) {
-      throw InputError(key, it->second.text, it->second.where, r.why);
+    } catch (const ValueError& e) {
+      throw InputError(key, it->second.text, it->second.where, e.what());
     }
     s.where[key] = it->second.where;
   }

@@ -13,6 +13,8 @@ DemModel::DemModel(ShearCell cell, const DemParams& params, IntegratorId scheme,
     : cell_(std::move(cell)), p_(params), scheme_(scheme), dt_(dt) {
   if (scheme_ != IntegratorId::verlet_exp && scheme_ != IntegratorId::overdamped)
     throw InputError("numerics.integrator", to_string(scheme_), "", "not available for dem_stokes yet");
+  cell_.free.v.resize(cell_.free.size(), Vec3::Zero());
+  cell_.free.f.resize(cell_.free.size(), Vec3::Zero());
   const double two_r = 2.0 * p_.radius;
   const double ff_range = p_.dipole_pref > 0 ? std::max(p_.dipole_cutoff, two_r) : two_r;
   lists_ = make_pair_lists(ff_range, cell_.walls.size() > 0 ? two_r : 0.0, p_.skin);
@@ -21,6 +23,7 @@ DemModel::DemModel(ShearCell cell, const DemParams& params, IntegratorId scheme,
 }
 
 void DemModel::update_forces() {
+  check_finite_positions();
   wrap_all(cell_.free.x, cell_.box);
   wrap_all(cell_.walls.x, cell_.box);
   if (needs_rebuild(lists_, cell_.free, cell_.box)) build_pair_lists(lists_, cell_.free, cell_.walls, cell_.box);
@@ -42,6 +45,17 @@ void DemModel::step() {
   update_forces();
   if (scheme_ == IntegratorId::verlet_exp)
     exp_verlet_correct(f.x, f.v, f.f, w_, p_.tau_p, p_.gamma, p_.shear_rate, dt_);
+}
+
+void DemModel::check_finite_positions() const {
+  const auto& f = cell_.free;
+  for (std::size_t i = 0; i < f.size(); ++i)
+    if (!f.x[i].allFinite() || !f.v[i].allFinite()) {
+      std::ostringstream s;
+      s << "non-finite " << (f.x[i].allFinite() ? "velocity" : "position") << " of particle " << i
+        << " at step " << steps_ << " (t = " << time_ << " s)";
+      throw NumericalError(s.str());
+    }
 }
 
 void DemModel::check_finite() const {

@@ -17,6 +17,11 @@ double expected_contact_load(const SceneConfig& c) {
   return magnetic + hydro;
 }
 
+double expected_impact_speed(const SceneConfig& c) {
+  const double pair = 2.0 * dipole_contact_force(c.radius, c.magnetization) / stokes_gamma(c.viscosity, c.radius);
+  return 2.0 * k_zeta3 * pair + 2.0 * c.radius * c.shear_rate;
+}
+
 DemParams dem_params(const SceneConfig& c) {
   DemParams p{};
   p.radius = c.radius;
@@ -32,6 +37,7 @@ DemParams dem_params(const SceneConfig& c) {
   p.viscosity = c.viscosity;
   p.contact_force = dipole_contact_force(c.radius, c.magnetization);
   p.expected_load = expected_contact_load(c);
+  p.impact_speed = expected_impact_speed(c);
   return p;
 }
 

@@ -40,7 +40,9 @@ TimeStepChoice choose_time_step(const LoadedScene& scene, const DemParams& p) {
       std::ostringstream why;
       why << "above the stability limit " << b.dt << " s of the " << to_string(t.scheme)
           << " integrator, set by '" << b.name << "' (" << b.basis << ")";
-      throw InputError("numerics.dt", std::to_string(*c.dt), scene.locate("numerics.dt"), why.str());
+      char value[32];
+      std::snprintf(value, sizeof value, "%.6g s", *c.dt);
+      throw InputError("numerics.dt", value, scene.locate("numerics.dt"), why.str());
     }
     t.dt = *c.dt;
   } else {
@@ -137,11 +139,17 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
 
   DemModel model(std::move(cell), p, ts.scheme, ts.dt);
   const long every = c.every > 0 ? c.every : std::max(1L, s.steps / 2000);
+  const double rows_after_warmup = (1.0 - c.warmup_strain / c.strain) * static_cast<double>(s.steps / every);
+  if (rows_after_warmup < 32)
+    throw InputError("output.every", std::to_string(every), scene.locate("output.every"),
+                     "leaves only " + std::to_string(static_cast<long>(rows_after_warmup)) +
+                         " time-series rows after the warm-up; block averaging needs at least 32");
   const long frame_every = c.frames > 0 ? std::max(1L, s.steps / c.frames) : 0;
   std::ofstream ts_out, frames_out;
   if (!opt.out_dir.empty()) {
     std::filesystem::create_directories(opt.out_dir);
     ts_out.open(opt.out_dir + "/timeseries.csv");
+    ts_out.precision(10);
     ts_out << "time_s,strain,stress_total_Pa,stress_particles_Pa,stress_fluid_Pa,"
               "stress_virial_magnetic_Pa,stress_virial_contact_Pa,max_overlap_over_radius,"
               "energy_dipole_J,energy_hertz_J\n";
@@ -166,7 +174,7 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
       ts_out << model.time() << "," << strain << "," << tp + s.stress_fluid << "," << tp << ","
              << s.stress_fluid << "," << vm << "," << vc << "," << row.max_overlap / p.radius << ","
              << row.e_dip * k << "," << row.e_hertz * k << "\n";
-    if (strain > c.warmup_strain) {
+    if (strain - row.n * ts.dt * c.shear_rate >= c.warmup_strain) {  // whole row after warm-up
       se.total.push_back(tp + s.stress_fluid);
       se.particles.push_back(tp);
       se.virial.push_back(vm + vc);

@@ -27,8 +27,10 @@ double verlet_exp_amplification(double omega, double tau, double dt);
 // Explicit-Euler overdamped limit for a pair of free spheres: dt < gamma/k_eff.
 double overdamped_contact_limit(double gamma, double k_eff);
 
-// Local Hertz stiffness at the overlap reached under `load` (N/m).
-double contact_stiffness_at_load(double hertz_k, double load);
+// Overlap (m) the contact limit is designed for: the static overlap under the
+// expected load, and for the inertial scheme also the overlap of a head-on
+// impact at the expected approach speed (REFERENCE TEST 2.1).
+double expected_overlap(const DemParams& p, IntegratorId scheme);
 
 // All limits of a DEM scene for the given scheme (verlet_exp or overdamped).
 std::vector<StabilityLimit> dem_limits(const DemParams& p, const SceneConfig& c, IntegratorId scheme);

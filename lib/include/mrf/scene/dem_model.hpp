@@ -29,6 +29,7 @@ class DemModel {
 
  private:
   void update_forces();
+  void check_finite_positions() const;  // before binning: the cell list needs finite coordinates
   void check_finite() const;
 
   ShearCell cell_;

@@ -19,6 +19,7 @@ struct DemParams {
   double viscosity;      // Pa s
   double contact_force;  // head-to-tail dipole force at contact (pi/6) mu0 R^2 M^2 (N)
   double expected_load;  // largest contact load the time step is designed for (N)
+  double impact_speed;   // largest expected approach speed of a contact pair (m/s)
 };
 
 DemParams dem_params(const SceneConfig& c);
@@ -27,6 +28,12 @@ DemParams dem_params(const SceneConfig& c);
 // tension (2 zeta(3) times the contact force, REFERENCE §1) plus the drag
 // of the shear flow on a gap-spanning chain, gamma gdot gap^2 / (16 R).
 double expected_contact_load(const SceneConfig& c);
+
+// Largest approach speed of two spheres meeting head-to-tail: the terminal
+// relative speed 2 F/gamma under the contact force F, times 2 zeta(3) for
+// chain ends pulled by whole chains (the random start makes such impacts),
+// plus the relative shear speed 2R gdot.
+double expected_impact_speed(const SceneConfig& c);
 
 // Dimensionless numbers reported with every run (REFERENCE §3, §8).
 double stokes_number(const DemParams& p);                    // tau_p gdot
