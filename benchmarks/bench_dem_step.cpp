@@ -33,8 +33,8 @@ void BM_PaperStep(benchmark::State& state, mrf::IntegratorId scheme) {
   for (auto _ : state) model.step();
   step_counters(state, model);
 }
-BENCHMARK_CAPTURE(BM_PaperStep, verlet_exp, mrf::IntegratorId::verlet_exp)->Unit(benchmark::kMicrosecond);
-BENCHMARK_CAPTURE(BM_PaperStep, overdamped, mrf::IntegratorId::overdamped)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_PaperStep, verlet_exp, mrf::IntegratorId::verlet_exp)->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_PaperStep, overdamped, mrf::IntegratorId::overdamped)->Unit(benchmark::kMicrosecond)->UseRealTime();
 
 void BM_PaperPairForces(benchmark::State& state) {
   mrf::DemModel model = paper_model(mrf::IntegratorId::verlet_exp);
@@ -45,7 +45,7 @@ void BM_PaperPairForces(benchmark::State& state) {
   }
   step_counters(state, model);
 }
-BENCHMARK(BM_PaperPairForces)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_PaperPairForces)->Unit(benchmark::kMicrosecond)->UseRealTime();
 
 void BM_PaperNeighbourBuild(benchmark::State& state) {
   mrf::DemModel model = paper_model(mrf::IntegratorId::verlet_exp);
@@ -53,6 +53,6 @@ void BM_PaperNeighbourBuild(benchmark::State& state) {
   for (auto _ : state) mrf::build_pair_lists(lists, model.cell().free, model.cell().walls, model.cell().box);
   state.counters["particles"] = static_cast<double>(model.cell().free.size());
 }
-BENCHMARK(BM_PaperNeighbourBuild)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_PaperNeighbourBuild)->Unit(benchmark::kMicrosecond)->UseRealTime();
 
 }  // namespace

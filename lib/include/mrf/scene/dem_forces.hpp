@@ -1,7 +1,10 @@
 // Pair forces of the DEM scene (dipole + Hertz between free particles, Hertz
 // between free and wall spheres) and the sums the stress observables need.
+// OpenMP over the half pair lists with one force buffer per thread, reduced
+// in thread order: bitwise reproducible for a fixed thread count.
 #pragma once
 #include <array>
+#include <vector>
 
 #include "mrf/box.hpp"
 #include "mrf/neighbors/verlet_list.hpp"
@@ -17,10 +20,20 @@ struct PairSums {
   double max_overlap = 0;               // m
   double energy_dipole = 0;             // J (within the cutoff, unshifted)
   double energy_hertz = 0;              // J
-  long pair_evaluations = 0;
+  long pair_evaluations = 0;            // pairs in the lists visited
+
+  void merge(const PairSums& o);
+};
+
+// Per-thread force buffers, kept between steps so the hot loop does not allocate.
+struct ForceBuffers {
+  std::vector<std::vector<Vec3>> f;
+  std::vector<PairSums> sums;
 };
 
 // Overwrites free.f with the pair forces and returns the sums.
+PairSums compute_dem_forces(const DemParams& p, const Box& box, FreeParticles& free,
+                            const WallParticles& walls, const DemPairLists& lists, ForceBuffers& buf);
 PairSums compute_dem_forces(const DemParams& p, const Box& box, FreeParticles& free,
                             const WallParticles& walls, const DemPairLists& lists);
 

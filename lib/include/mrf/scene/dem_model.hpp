@@ -38,6 +38,7 @@ class DemModel {
   double dt_;
   DemPairLists lists_;
   PairSums sums_;
+  ForceBuffers buffers_;
   std::vector<Vec3> w_;  // drift velocities of the current step (scratch)
   double time_ = 0;
   long steps_ = 0;
