@@ -1,0 +1,43 @@
+// Fluid-only start-up Couette run of the SPH carrier in the shear cell, from
+// a scene (model demsph_*, volume_fraction = 0): the entry point for
+// `mrf run` and the end-to-end check of the fluid solver.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "mrf/fluid/fluid_cell.hpp"
+#include "mrf/fluid/wcsph.hpp"
+#include "mrf/scene/config.hpp"
+
+namespace mrf {
+
+// Fluid parameters of a scene: [fluid] viscosity, density, sph_spacing,
+// sound_speed and [drive] shear_rate (no body force).
+FluidParams fluid_params_from_scene(const SceneConfig& cfg);
+
+struct CouetteSphResult {
+  double time = 0;                   // simulated time reached (s)
+  double shear_stress = 0;           // tau from the wall forces at `time` (Pa)
+  double analytic_stress = 0;        // eta du/dx at the walls, start-up series at `time` (Pa)
+  double steady_stress = 0;          // eta gdot (Pa)
+  double profile_error = 0;          // relative L2 error of v_z vs the start-up series (1)
+  double mean_density_error = 0;     // mean |rho/rho0 - 1| at the end (1)
+  double max_density_deviation = 0;  // largest |rho/rho0 - 1| seen during the run (1)
+  double reynolds = 0;               // rho gdot gap^2 / eta (1)
+  double sound_speed = 0;            // c0 used (m/s)
+  bool implicit_viscosity = false;
+  double dt = 0;                     // s
+  std::int64_t steps = 0;
+  std::vector<SphStepLimit> limits;  // of the scheme used, at start
+  double wall_seconds = 0;
+  std::size_t n_fluid = 0, n_wall = 0;
+};
+
+// Runs from rest for `t_end` seconds. Viscosity is implicit for integrator
+// "implicit", and for "auto" when the viscous limit is the binding one;
+// explicit otherwise. dt = cfg.dt (refused above a limit) or
+// cfg.dt_safety x the binding limit, shortened to land on t_end.
+// Throws InputError for a non-SPH model or volume_fraction != 0.
+CouetteSphResult run_couette_sph(const SceneConfig& cfg, double t_end);
+
+}  // namespace mrf

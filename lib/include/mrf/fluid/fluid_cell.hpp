@@ -1,0 +1,84 @@
+// State of the SPH carrier fluid in the shear cell: fluid particles, wall
+// particles and the neighbour pairs, as plain structures of arrays.
+//
+// Geometry (DESIGN.md): the no-slip planes are x = -gap/2 and x = +gap/2, the
+// DEM wall-sphere centres. Fluid particles start on a simple cubic lattice
+// at x = -gap/2 + (i + 1/2) dx; wall particles continue that lattice in
+// ceil(2h/dx) layers beyond each plane, so a fluid particle next to the wall
+// has full kernel support, and move rigidly with v = (0, 0, gdot x_wall).
+// y and z are periodic.
+//
+// Invariant kept by build_fluid_cell and the steps: `pairs`, `rho`, `p` and
+// the wall pressures are those of the current positions (refresh()).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "mrf/box.hpp"
+#include "mrf/fluid/fluid_params.hpp"
+
+namespace mrf {
+
+struct FluidParticles {
+  std::vector<Vec3> x;      // position (m), y and z wrapped into the box
+  std::vector<Vec3> v;      // velocity (m/s)
+  std::vector<Vec3> a_ext;  // extra acceleration (m/s^2): hook for the DEM back-reaction (REFERENCE §6)
+  std::vector<double> rho;  // summation density (kg/m^3)
+  std::vector<double> p;    // pressure (Pa)
+  std::size_t size() const { return x.size(); }
+};
+
+struct FluidWallParticles {
+  std::vector<Vec3> x;      // position (m)
+  std::vector<Vec3> v;      // prescribed wall velocity (m/s)
+  std::vector<double> depth;  // distance beyond the wall plane (m), > 0
+  std::vector<int> side;    // -1 lower wall, +1 upper wall
+  std::vector<double> rho;  // density from the inverse EOS of p (kg/m^3)
+  std::vector<double> p;    // extrapolated pressure, Adami et al. 2012 (Pa)
+  std::size_t size() const { return x.size(); }
+};
+
+// One interacting pair within the kernel support, with the separation of
+// the periodic image that interacts: r_ab = x_a - x_b (m), r = |r_ab|.
+// When ly or lz < 4h a pair can interact through two images; each image is
+// then its own entry.
+struct SphPair {
+  std::uint32_t a, b;
+  Vec3 r_ab;
+  double r;
+};
+
+struct SphPairs {
+  std::vector<SphPair> fluid_fluid;  // a < b, both fluid, each image once
+  std::vector<SphPair> fluid_wall;   // a fluid, b wall
+};
+
+struct FluidCell {
+  Box box;
+  FluidParams params;
+  double h = 0;            // smoothing length (m)
+  double mass = 0;         // particle mass rho0 dx^3, fluid and wall (kg)
+  double density_scale = 1;  // 1/S1 = 1/lattice_kernel_sum: summation density normalisation (1)
+  double c0 = 0;           // sound speed (m/s)
+  double viscous_scale = 1;  // morris_lattice_correction (1)
+  FluidParticles fluid;
+  FluidWallParticles wall;
+  SphPairs pairs;
+  double time = 0;         // s
+  std::int64_t steps = 0;
+};
+
+// Lattice of fluid at rest between the walls (params validated here).
+FluidCell build_fluid_cell(const Box& box, const FluidParams& params);
+
+// Velocity of the wall on `side` (-1 lower, +1 upper): (0, 0, gdot side gap/2).
+Vec3 wall_velocity(const FluidCell& cell, int side);
+
+// Recompute the neighbour pairs, summation densities, fluid pressures and
+// wall pressures at the current positions.
+void refresh(FluidCell& cell);
+
+// Neighbour pairs of the current positions (cell lists, periodic images).
+SphPairs find_pairs(const FluidCell& cell);
+
+}  // namespace mrf

@@ -1,0 +1,116 @@
+#include "mrf/fluid/fluid_cell.hpp"
+
+#include <cmath>
+
+#include "mrf/fluid/kernel.hpp"
+#include "mrf/fluid/viscosity.hpp"
+#include "mrf/neighbors/cell_list.hpp"
+
+namespace mrf {
+
+namespace {
+
+int count_along(double length, double dx) { return static_cast<int>(std::lround(length / dx)); }
+
+// Call f(r_ab, r) for every periodic image of d = x_a - x_b closer than rc.
+// A second image along y (z) can lie within rc only when ly (lz) < 2 rc;
+// validation keeps ly, lz > rc, so no particle meets its own image.
+template <class F>
+void for_each_image(const Box& box, const Vec3& d, double rc, F&& f) {
+  if (std::abs(d.x()) >= rc) return;  // x is not periodic: cheap rejection first
+  const Vec3 m = box.min_image(d);
+  const double rc2 = rc * rc, dx2 = m.x() * m.x();
+  const int ky = box.ly < 2.0 * rc ? 1 : 0;
+  const int kz = box.lz < 2.0 * rc ? 1 : 0;
+  for (int iz = -kz; iz <= kz; ++iz) {
+    const double ez = m.z() + iz * box.lz;
+    if (dx2 + ez * ez >= rc2) continue;
+    for (int iy = -ky; iy <= ky; ++iy) {
+      const double ey = m.y() + iy * box.ly;
+      const double r2 = dx2 + ey * ey + ez * ez;
+      if (r2 < rc2) f(Vec3(m.x(), ey, ez), std::sqrt(r2));
+    }
+  }
+}
+
+void add_wall(FluidCell& cell, int side, int layers) {
+  const double dx = cell.params.spacing;
+  const int ny = count_along(cell.box.ly, dx), nz = count_along(cell.box.lz, dx);
+  const Vec3 v = wall_velocity(cell, side);
+  FluidWallParticles& w = cell.wall;
+  for (int l = 0; l < layers; ++l) {
+    const double depth = (l + 0.5) * dx;
+    for (int j = 0; j < ny; ++j)
+      for (int k = 0; k < nz; ++k) {
+        w.x.emplace_back(side * (0.5 * cell.box.gap + depth), (j + 0.5) * dx, (k + 0.5) * dx);
+        w.v.push_back(v);
+        w.depth.push_back(depth);
+        w.side.push_back(side);
+      }
+  }
+  w.rho.assign(w.x.size(), cell.params.density);
+  w.p.assign(w.x.size(), 0.0);
+}
+
+}  // namespace
+
+Vec3 wall_velocity(const FluidCell& cell, int side) {
+  return Vec3(0.0, 0.0, cell.params.shear_rate * side * 0.5 * cell.box.gap);
+}
+
+FluidCell build_fluid_cell(const Box& box, const FluidParams& params) {
+  params.validate(box);
+  FluidCell cell;
+  cell.box = box;
+  cell.params = params;
+  cell.h = params.h();
+  const double dx = params.spacing;
+  // Mass rho0 dx^3 so the particles carry the true mass density; the
+  // summation density is divided by the lattice sum S1 so that the
+  // undisturbed lattice has density rho0 exactly (no spurious pressure).
+  cell.mass = params.density * dx * dx * dx;
+  cell.density_scale = 1.0 / lattice_kernel_sum(dx, cell.h);
+  cell.c0 = sound_speed(params, box);
+  cell.viscous_scale = morris_lattice_correction(dx, cell.h);
+  const int nx = count_along(box.gap, dx), ny = count_along(box.ly, dx), nz = count_along(box.lz, dx);
+  FluidParticles& f = cell.fluid;
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < ny; ++j)
+      for (int k = 0; k < nz; ++k)
+        f.x.emplace_back(-0.5 * box.gap + (i + 0.5) * dx, (j + 0.5) * dx, (k + 0.5) * dx);
+  f.v.assign(f.x.size(), Vec3::Zero());
+  f.a_ext.assign(f.x.size(), Vec3::Zero());
+  const int layers = static_cast<int>(std::ceil(k_kernel_support * cell.h / dx));
+  add_wall(cell, -1, layers);
+  add_wall(cell, +1, layers);
+  refresh(cell);
+  return cell;
+}
+
+SphPairs find_pairs(const FluidCell& cell) {
+  SphPairs out;
+  out.fluid_fluid.reserve(cell.pairs.fluid_fluid.size());
+  out.fluid_wall.reserve(cell.pairs.fluid_wall.size());
+  const Box& box = cell.box;
+  const double rc = k_kernel_support * cell.h;
+  const double reach = 0.5 * box.gap + cell.wall.depth.back() + cell.params.spacing;
+  CellGrid grid(box, -reach, reach, rc);
+  const auto& xf = cell.fluid.x;
+  grid.bin(xf);
+  for (std::uint32_t a = 0; a < xf.size(); ++a)
+    grid.for_each_candidate(xf[a], [&](std::uint32_t b) {
+      if (b <= a) return;
+      for_each_image(box, xf[a] - xf[b], rc,
+                     [&](const Vec3& e, double r) { out.fluid_fluid.push_back({a, b, e, r}); });
+    });
+  const auto& xw = cell.wall.x;
+  grid.bin(xw);
+  for (std::uint32_t a = 0; a < xf.size(); ++a)
+    grid.for_each_candidate(xf[a], [&](std::uint32_t b) {
+      for_each_image(box, xf[a] - xw[b], rc,
+                     [&](const Vec3& e, double r) { out.fluid_wall.push_back({a, b, e, r}); });
+    });
+  return out;
+}
+
+}  // namespace mrf

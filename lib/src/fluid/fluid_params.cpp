@@ -1,0 +1,80 @@
+#include "mrf/fluid/fluid_params.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "mrf/error.hpp"
+#include "mrf/fluid/kernel.hpp"
+
+namespace mrf {
+
+namespace {
+
+std::string num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+void require_positive(const char* key, double v) {
+  if (!(v > 0) || !std::isfinite(v)) throw InputError(key, num(v), "", "must be positive and finite");
+}
+
+// True when length / dx is a whole number to 1e-6 relative.
+bool is_multiple(double length, double dx) {
+  const double n = length / dx;
+  return std::abs(n - std::round(n)) < 1e-6 * std::max(1.0, n);
+}
+
+}  // namespace
+
+void FluidParams::validate(const Box& box) const {
+  require_positive("fluid.viscosity", viscosity);
+  require_positive("fluid.density", density);
+  require_positive("fluid.sph_spacing", spacing);
+  if (!(h_over_dx >= 1.0 && h_over_dx <= 2.5))
+    throw InputError("fluid.h_over_dx", num(h_over_dx), "", "must lie in [1, 2.5]");
+  if (!(sound_speed >= 0) || !std::isfinite(sound_speed))
+    throw InputError("fluid.sound_speed", num(sound_speed), "", "must be >= 0 (0 = automatic)");
+  if (!std::isfinite(shear_rate)) throw InputError("drive.shear_rate", num(shear_rate), "", "must be finite");
+  if (!std::isfinite(body_force)) throw InputError("fluid.body_force", num(body_force), "", "must be finite");
+  if (!(density_tolerance > 0 && density_tolerance < 0.1))
+    throw InputError("fluid.density_tolerance", num(density_tolerance), "", "must lie in (0, 0.1)");
+  if (!(cg_tolerance > 0 && cg_tolerance < 1e-3))
+    throw InputError("fluid.cg_tolerance", num(cg_tolerance), "", "must lie in (0, 1e-3)");
+  const struct {
+    const char* key;
+    double length;
+  } sides[] = {{"box.gap", box.gap}, {"box.ly", box.ly}, {"box.lz", box.lz}};
+  for (const auto& s : sides) {
+    require_positive(s.key, s.length);
+    if (!is_multiple(s.length, spacing))
+      throw InputError("fluid.sph_spacing", num(spacing), "",
+                       std::string("must divide ") + s.key + " = " + num(s.length) + " a whole number of times");
+  }
+  const double support = k_kernel_support * h();
+  if (box.ly <= support || box.lz <= support)
+    throw InputError("fluid.sph_spacing", num(spacing), "",
+                     "kernel support 2h = " + num(support) + " m must be shorter than box.ly and box.lz");
+}
+
+double morris_sound_speed(double v0, double l0, double nu, double body_force, double delta) {
+  const double c2 = std::max({v0 * v0, nu * v0 / l0, std::abs(body_force) * l0}) / delta;
+  return std::sqrt(c2);
+}
+
+double sound_speed(const FluidParams& p, const Box& box) {
+  if (p.sound_speed > 0) return p.sound_speed;
+  const double nu = p.kinematic_viscosity();
+  const double l0 = 0.5 * box.gap;
+  const double v0 = std::max(std::abs(p.shear_rate) * l0, std::abs(p.body_force) * box.gap * box.gap / (8.0 * nu));
+  const double c0 = morris_sound_speed(v0, l0, nu, p.body_force, p.density_tolerance);
+  if (!(c0 > 0))
+    throw InputError("fluid.sound_speed", "0", "",
+                     "cannot be chosen automatically without flow (shear_rate = body_force = 0); give it");
+  return c0;
+}
+
+}  // namespace mrf
