@@ -44,6 +44,7 @@ std::string summary_json(const RunSummary& s) {
   j["magnetization"] = s.magnetization;
   j["volume_fraction"] = s.volume_fraction;
   j["seed"] = s.seed;
+  for (const auto& [key, value] : s.extra) j[key] = value;
   j["version"] = MRF_VERSION;
   return j.dump(2);
 }

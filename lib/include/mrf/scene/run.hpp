@@ -2,6 +2,7 @@
 // limits, integrate to the requested strain, write timeseries.csv and
 // summary.json, and return the summary.
 #pragma once
+#include <map>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,7 @@ struct RunSummary {
   double youngs_modulus = 0, density = 0, magnetization = 0, volume_fraction = 0;
   std::uint64_t seed = 0;
   int threads = 1;
+  std::map<std::string, double> extra;  // model-specific keys, written into summary.json as they are
 };
 
 RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt);
