@@ -1,0 +1,77 @@
+// Kernels of the unresolved two-way SPH-DEM coupling (REFERENCE.md §6,
+// Robinson, Ramaioli & Luding 2014): porosity at the SPH particles, Shepard
+// interpolation of fluid fields at the DEM particles, and the exactly
+// momentum-conserving back-reaction of the particle forces on the fluid.
+// Pure functions of positions, fields and a pair list; no time integration.
+//
+// One pair list (DEM particle i, SPH particle a, W(r_ia, h)) serves scatter
+// AND gather, so both use the same kernel and h by construction; that is what
+// makes sum_a m_a a_a^c = -sum_i F_i exact (TEST 6.1). The kernel width is the
+// SPH smoothing length h (Wendland C2, support 2h). SI units throughout.
+//
+// Density convention: `rho` is whatever density divides the SPH sums (§6: the
+// superficial density rho_bar = eps rho_f in Robinson's model A). The identity
+// is exact only if the SAME rho array is passed to shepard_interpolate (for
+// s_i) and to add_back_coupling.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "mrf/box.hpp"
+
+namespace mrf {
+
+// One DEM-SPH pair within the kernel support 2h: W = W(|x_i - x_a|, h) (1/m^3)
+// of the minimum image.
+struct CouplingPair {
+  std::uint32_t i;  // DEM particle
+  std::uint32_t a;  // SPH particle
+  double w;
+};
+
+// All DEM-SPH pairs closer than 2h (cell lists, minimum image in y and z).
+// Requires ly, lz >= 4h so that at most one periodic image interacts (the
+// neighbour search returns only the minimum image); throws
+// std::invalid_argument otherwise or if h <= 0.
+std::vector<CouplingPair> coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x,
+                                         const Box& box, double h);
+
+// Default porosity floor: eps below it (overlapping kernels of a dense packing)
+// would make the drag and eps-weighted densities blow up; 0.2 is well below
+// random close packing (eps ~ 0.36), so a physical packing is not clamped.
+inline constexpr double k_porosity_floor = 0.2;
+
+struct PorosityField {
+  std::vector<double> eps;  // per SPH particle, in [floor, 1] (1)
+  std::size_t clamped = 0;  // how many were raised to the floor
+};
+
+// eps_a = max(floor, 1 - sum_i V_p W(r_ai, h)); V_p the DEM particle volume
+// (all particles of one species, m^3).
+PorosityField porosity_at_fluid(std::size_t n_sph, double particle_volume, const std::vector<CouplingPair>& pairs,
+                                double floor = k_porosity_floor);
+
+struct ShepardField {
+  std::vector<double> s;    // s_i = sum_a (m/rho_a) W_ia (1)
+  std::vector<Vec3> u;      // u_i = sum_a (m/rho_a) W_ia v_a / s_i (m/s)
+  std::vector<double> eps;  // eps_i, same weights (1)
+};
+
+// Shepard interpolation at the n_dem DEM particles from SPH particles of mass
+// `mass` (kg), density rho (kg/m^3), velocity v and porosity eps. Throws
+// NumericalError naming the first DEM particle with s_i = 0 (no SPH
+// neighbour within 2h).
+ShepardField shepard_interpolate(std::size_t n_dem, const std::vector<CouplingPair>& pairs, double mass,
+                                 const std::vector<double>& rho, const std::vector<Vec3>& v,
+                                 const std::vector<double>& eps);
+
+// Back-reaction of the fluid-to-particle forces F_i (N) on the SPH particles:
+//   a_out[a] += -(1/rho_a) sum_i F_i W_ia / s_i   (m/s^2),
+// accumulated (e.g. into FluidParticles::a_ext). With s from
+// shepard_interpolate on the same pairs, mass and rho:
+//   sum_a mass a_a^c = -sum_i F_i   to round-off.
+void add_back_coupling(const std::vector<CouplingPair>& pairs, const std::vector<Vec3>& force,
+                       const std::vector<double>& s, const std::vector<double>& rho, std::vector<Vec3>& a_out);
+
+}  // namespace mrf

@@ -1,0 +1,72 @@
+// Unresolved SPH-DEM coupling kernels, REFERENCE.md §6. See exchange.hpp.
+#include "mrf/coupling/exchange.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+#include "mrf/error.hpp"
+#include "mrf/fluid/kernel.hpp"
+#include "mrf/neighbors/cell_list.hpp"
+
+namespace mrf {
+
+std::vector<CouplingPair> coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x,
+                                         const Box& box, double h) {
+  if (!(h > 0.0)) throw std::invalid_argument("coupling_pairs: smoothing length h must be > 0");
+  const double rc = k_kernel_support * h;
+  if (box.ly < 2.0 * rc || box.lz < 2.0 * rc)
+    throw std::invalid_argument("coupling_pairs: ly and lz must be >= 4h (one periodic image per pair)");
+  const std::vector<IndexPair> idx = cross_pairs(dem_x, sph_x, box, rc);
+  std::vector<CouplingPair> out;
+  out.reserve(idx.size());
+  for (const auto& [i, a] : idx) {
+    const double r = box.min_image(dem_x[i] - sph_x[a]).norm();
+    out.push_back({i, a, kernel_w(r, h)});
+  }
+  return out;
+}
+
+PorosityField porosity_at_fluid(std::size_t n_sph, double particle_volume, const std::vector<CouplingPair>& pairs,
+                                double floor) {
+  std::vector<double> solid(n_sph, 0.0);
+  for (const CouplingPair& p : pairs) solid[p.a] += particle_volume * p.w;
+  PorosityField out;
+  out.eps.resize(n_sph);
+  for (std::size_t a = 0; a < n_sph; ++a) {
+    const double e = 1.0 - solid[a];
+    if (e < floor) ++out.clamped;
+    out.eps[a] = std::max(e, floor);
+  }
+  return out;
+}
+
+ShepardField shepard_interpolate(std::size_t n_dem, const std::vector<CouplingPair>& pairs, double mass,
+                                 const std::vector<double>& rho, const std::vector<Vec3>& v,
+                                 const std::vector<double>& eps) {
+  ShepardField out;
+  out.s.assign(n_dem, 0.0);
+  out.u.assign(n_dem, Vec3::Zero());
+  out.eps.assign(n_dem, 0.0);
+  for (const CouplingPair& p : pairs) {
+    const double wv = mass / rho[p.a] * p.w;
+    out.s[p.i] += wv;
+    out.u[p.i] += wv * v[p.a];
+    out.eps[p.i] += wv * eps[p.a];
+  }
+  for (std::size_t i = 0; i < n_dem; ++i) {
+    if (!(out.s[i] > 0.0))
+      throw NumericalError("shepard_interpolate: DEM particle " + std::to_string(i) +
+                           " has no SPH neighbour within 2h (Shepard sum s_i = " + std::to_string(out.s[i]) + ")");
+    out.u[i] /= out.s[i];
+    out.eps[i] /= out.s[i];
+  }
+  return out;
+}
+
+void add_back_coupling(const std::vector<CouplingPair>& pairs, const std::vector<Vec3>& force,
+                       const std::vector<double>& s, const std::vector<double>& rho, std::vector<Vec3>& a_out) {
+  for (const CouplingPair& p : pairs) a_out[p.a] -= (p.w / (rho[p.a] * s[p.i])) * force[p.i];
+}
+
+}  // namespace mrf
