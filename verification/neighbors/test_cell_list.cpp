@@ -41,6 +41,22 @@ TEST_P(CellListVsBruteForce, SelfPairsIdentical) {
   }
 }
 
+TEST_P(CellListVsBruteForce, PairRowsHoldTheSamePairs) {
+  const auto [box, rc] = GetParam();
+  const auto pts = random_points(400, box, 21);
+  PairRows rows;
+  self_pair_rows(pts, box, rc, rows);
+  ASSERT_EQ(rows.start.size(), pts.size() + 1);
+  std::vector<IndexPair> flat;
+  for (std::uint32_t i = 0; i < pts.size(); ++i)
+    for (std::uint32_t n = rows.start[i]; n < rows.start[i + 1]; ++n) {
+      EXPECT_GT(rows.k[n], i);  // each pair once, in the row of its smaller index
+      flat.emplace_back(i, rows.k[n]);
+    }
+  EXPECT_EQ(rows.size(), flat.size());
+  EXPECT_EQ(sorted(flat), sorted(brute_force_self_pairs(pts, box, rc)));
+}
+
 TEST_P(CellListVsBruteForce, CrossPairsIdentical) {
   const auto [box, rc] = GetParam();
   const auto a = random_points(300, box, 11);

@@ -76,6 +76,26 @@ std::vector<IndexPair> self_pairs(const std::vector<Vec3>& pts, const Box& box, 
   return out;
 }
 
+void self_pair_rows(const std::vector<Vec3>& pts, const Box& box, double cutoff, PairRows& out) {
+  out.k.clear();
+  out.start.assign(pts.empty() ? 0 : pts.size() + 1, 0);
+  if (pts.empty()) return;
+  double lo = std::numeric_limits<double>::max(), hi = std::numeric_limits<double>::lowest();
+  extent(pts, lo, hi);
+  CellGrid grid(box, lo, hi, cutoff);
+  grid.bin(pts);
+  const double rc2 = cutoff * cutoff;
+  const MinImageYZ mi(box);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const Vec3 xi = pts[i];
+    grid.for_each_candidate(xi, [&](std::uint32_t j) {
+      if (j <= i) return;
+      if (mi.norm2(xi, pts[j]) < rc2) out.k.push_back(j);
+    });
+    out.start[i + 1] = static_cast<std::uint32_t>(out.k.size());
+  }
+}
+
 std::vector<IndexPair> cross_pairs(const std::vector<Vec3>& a, const std::vector<Vec3>& b,
                                    const Box& box, double cutoff) {
   std::vector<IndexPair> out;
@@ -86,9 +106,10 @@ std::vector<IndexPair> cross_pairs(const std::vector<Vec3>& a, const std::vector
   CellGrid grid(box, lo, hi, cutoff);
   grid.bin(b);
   const double rc2 = cutoff * cutoff;
+  const MinImageYZ mi(box);
   for (std::size_t i = 0; i < a.size(); ++i) {
     grid.for_each_candidate(a[i], [&](std::uint32_t j) {
-      if (box.min_image(a[i] - b[j]).squaredNorm() < rc2)
+      if (mi.norm2(a[i], b[j]) < rc2)
         out.emplace_back(static_cast<std::uint32_t>(i), j);
     });
   }

@@ -11,6 +11,35 @@ namespace mrf {
 
 using IndexPair = std::pair<std::uint32_t, std::uint32_t>;
 
+// A half pair list stored by rows (CSR): the partners of point i are
+// k[start[i]], ..., k[start[i + 1] - 1], all with index > i.
+struct PairRows {
+  std::vector<std::uint32_t> start;  // size points + 1 (empty when there are no points)
+  std::vector<std::uint32_t> k;
+  std::size_t size() const { return k.size(); }
+  std::size_t rows() const { return start.empty() ? 0 : start.size() - 1; }
+};
+
+// Branch-free minimum image in y and z with precomputed inverse lengths.
+// Rounds to nearest (ties to even, as std::nearbyint) by adding and
+// subtracting 1.5 * 2^52, exact for |d / l| < 2^51; needs IEEE evaluation
+// (no -ffast-math), which the build uses.
+struct MinImageYZ {
+  double ly, lz, inv_ly, inv_lz;
+  explicit MinImageYZ(const Box& b) : ly(b.ly), lz(b.lz), inv_ly(1.0 / b.ly), inv_lz(1.0 / b.lz) {}
+  static double round_nearest(double t) {
+    constexpr double k_magic = 6755399441055744.0;  // 1.5 * 2^52
+    return (t + k_magic) - k_magic;
+  }
+  double wrap_y(double dy) const { return dy - ly * round_nearest(dy * inv_ly); }
+  double wrap_z(double dz) const { return dz - lz * round_nearest(dz * inv_lz); }
+  // |minimum image of a - b|^2
+  double norm2(const Vec3& a, const Vec3& b) const {
+    const double dx = a.x() - b.x(), dy = wrap_y(a.y() - b.y()), dz = wrap_z(a.z() - b.z());
+    return dx * dx + dy * dy + dz * dz;
+  }
+};
+
 // A uniform grid of cells no smaller than `min_cell` along each axis.
 // Along y or z a periodic direction with fewer than 3 cells is collapsed to
 // one cell (every point is then a candidate along it), which keeps the
@@ -55,6 +84,8 @@ class CellGrid {
 
 // All pairs i < j of `pts` closer than `cutoff` (minimum image), via cells.
 std::vector<IndexPair> self_pairs(const std::vector<Vec3>& pts, const Box& box, double cutoff);
+// The same pairs as rows i -> {j > i}, written into `out` (reuses its storage).
+void self_pair_rows(const std::vector<Vec3>& pts, const Box& box, double cutoff, PairRows& out);
 // All pairs (i in a, j in b) closer than `cutoff`, via cells.
 std::vector<IndexPair> cross_pairs(const std::vector<Vec3>& a, const std::vector<Vec3>& b,
                                    const Box& box, double cutoff);
