@@ -104,10 +104,37 @@ void write_frame(std::ofstream& out, const ShearCell& cell, double radius, doubl
 
 }  // namespace
 
+// Everything summary.json states about a DEM run before it starts.
+static RunSummary dem_summary_header(const SceneConfig& c, const DemParams& p, const TimeStepChoice& ts,
+                                     const ShearCell& cell) {
+  RunSummary s;
+  s.model = to_string(c.model);
+  s.integrator = to_string(ts.scheme);
+  s.binding_limit = binding(ts.limits).name;
+  s.mason = c.mason;
+  s.shear_rate = c.shear_rate;
+  s.strain = c.strain;
+  s.warmup_strain = c.warmup_strain;
+  s.dt = ts.dt;
+  s.steps = static_cast<long>(std::ceil(c.strain / (c.shear_rate * ts.dt)));
+  s.n_particles = static_cast<long>(cell.free.size());
+  s.n_wall = static_cast<long>(cell.walls.size());
+  s.stokes_number = stokes_number(p);
+  s.reynolds_number = particle_reynolds(c);
+  s.stress_fluid = imposed_fluid_stress(c.viscosity, c.shear_rate);
+  s.youngs_modulus = c.youngs_modulus;
+  s.density = c.density;
+  s.magnetization = c.magnetization;
+  s.volume_fraction = c.volume_fraction;
+  s.seed = c.seed;
+  s.threads = omp_get_max_threads();
+  return s;
+}
+
 // A fluid-only SPH shear cell (model demsph_*, no particles): start-up
 // Couette flow to the requested strain; the stress is the wall stress at the
 // end, with the start-up series beside it (no averaging window: one value).
-RunSummary run_fluid_only(const LoadedScene& scene, const RunOptions& opt) {
+static RunSummary run_fluid_only(const LoadedScene& scene, const RunOptions& opt) {
   const SceneConfig& c = scene.config;
   const CouetteSphResult r = run_couette_sph(c, c.strain / c.shear_rate);
   RunSummary s;
@@ -165,27 +192,7 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
   ShearCell cell = build_shear_cell(c, scene.locate("particles.volume_fraction"));
   for (std::size_t i = 0; i < cell.free.size(); ++i) cell.free.v[i] = couette_velocity(cell.free.x[i], c.shear_rate);
 
-  RunSummary s;
-  s.model = to_string(c.model);
-  s.integrator = to_string(ts.scheme);
-  s.binding_limit = binding(ts.limits).name;
-  s.mason = c.mason;
-  s.shear_rate = c.shear_rate;
-  s.strain = c.strain;
-  s.warmup_strain = c.warmup_strain;
-  s.dt = ts.dt;
-  s.steps = static_cast<long>(std::ceil(c.strain / (c.shear_rate * ts.dt)));
-  s.n_particles = static_cast<long>(cell.free.size());
-  s.n_wall = static_cast<long>(cell.walls.size());
-  s.stokes_number = stokes_number(p);
-  s.reynolds_number = particle_reynolds(c);
-  s.stress_fluid = imposed_fluid_stress(c.viscosity, c.shear_rate);
-  s.youngs_modulus = c.youngs_modulus;
-  s.density = c.density;
-  s.magnetization = c.magnetization;
-  s.volume_fraction = c.volume_fraction;
-  s.seed = c.seed;
-  s.threads = omp_get_max_threads();
+  RunSummary s = dem_summary_header(c, p, ts, cell);
   if (!opt.quiet) print_limits(ts, s);
 
   DemModel model(std::move(cell), p, ts.scheme, ts.dt);
