@@ -111,9 +111,6 @@ const StabilityLimit& binding(const std::vector<StabilityLimit>& limits) {
                            [](const auto& a, const auto& b) { return a.dt < b.dt; });
 }
 
-}  // namespace mrf
-
-namespace mrf {
 double critical_overlap(const DemParams& p, IntegratorId scheme, double dt) {
   // contact_limit_at_overlap decreases with overlap; bisect in log space.
   double lo = 1e-16 * p.radius, hi = p.radius;
@@ -125,4 +122,5 @@ double critical_overlap(const DemParams& p, IntegratorId scheme, double dt) {
   }
   return lo;
 }
+
 }  // namespace mrf

@@ -41,10 +41,8 @@ double contact_limit_at_overlap(const DemParams& p, IntegratorId scheme, double 
 double smallest(const std::vector<StabilityLimit>& limits);
 const StabilityLimit& binding(const std::vector<StabilityLimit>& limits);
 
-}  // namespace mrf
-
-namespace mrf {
 // Largest overlap (m) whose Hertz stiffness the scheme still integrates
 // stably at time step dt (bisection on the monotone contact limit).
 double critical_overlap(const DemParams& p, IntegratorId scheme, double dt);
+
 }  // namespace mrf

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "mrf/box.hpp"
+#include "mrf/forces/drag.hpp"
 #include "mrf/state.hpp"
 
 namespace mrf {
@@ -11,9 +12,7 @@ namespace mrf {
 // Target velocity of the drag relaxation, w = u(x) + f/gamma, with the
 // imposed Couette profile u = (0, 0, gdot x_x).
 inline Vec3 drift_velocity(const Vec3& x, const Vec3& f, double inv_gamma, double shear_rate) {
-  Vec3 w = inv_gamma * f;
-  w.z() += shear_rate * x.x();
-  return w;
+  return couette_velocity(x, shear_rate) + inv_gamma * f;
 }
 
 // Exponential velocity Verlet, first half: with w_n frozen over the step the
