@@ -12,6 +12,7 @@
 #include "mrf/error.hpp"
 #include "mrf/fluid/couette_sph.hpp"
 #include "mrf/forces/drag.hpp"
+#include "mrf/io/atomic_file.hpp"
 #include "mrf/observe/block_average.hpp"
 #include "mrf/observe/stress.hpp"
 #include "mrf/scene/dem_model.hpp"
@@ -173,7 +174,7 @@ static RunSummary run_fluid_only(const LoadedScene& scene, const RunOptions& opt
     ts << "time_s,strain,stress_total_Pa,stress_startup_series_Pa,profile_error_l2\n"
        << r.time << "," << r.time * c.shear_rate << "," << r.shear_stress << "," << r.analytic_stress
        << "," << r.profile_error << "\n";
-    std::ofstream(opt.out_dir + "/summary.json") << summary_json(s) << "\n";
+    write_file_atomic(opt.out_dir + "/summary.json", summary_json(s) + "\n");
   }
   return s;
 }
@@ -262,7 +263,7 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
   s.neighbor_builds = model.lists().builds;
   s.particle_steps_per_second = static_cast<double>(s.n_particles * s.steps) / s.wall_seconds;
   s.pair_evaluations_per_second = static_cast<double>(pair_evals) / s.wall_seconds;
-  if (!opt.out_dir.empty()) std::ofstream(opt.out_dir + "/summary.json") << summary_json(s) << "\n";
+  if (!opt.out_dir.empty()) write_file_atomic(opt.out_dir + "/summary.json", summary_json(s) + "\n");
   return s;
 }
 

@@ -1,0 +1,104 @@
+// A sweep: a grid of models x Mason numbers x seeds over one base scene
+// (DESIGN.md, `mrf sweep`). Each point is an independent run with its own
+// output folder; a point whose summary.json exists is finished and skipped,
+// so a killed sweep resumes where it stopped. Points are dealt to ranks
+// round-robin (index % size == rank), so `mpirun -n K mrf sweep` splits the
+// grid without any communication.
+//
+// Sweep file (TOML; paths relative to the sweep file):
+//   [sweep]
+//   scene  = "../scenes/small_dem_stokes.toml"
+//   models = ["dem_stokes", "demsph_stokes", "demsph_dd"]
+//   mason  = [1e-3, 1e-2, 1e-1, 1.0]
+//   seeds  = [1, 2]
+//   set    = ["drive.strain=6"]          # overrides for every point (optional)
+//   [[rule]]                              # extra overrides for matching points (optional)
+//   mason_max = 2e-3                      # matches mason <= mason_max (optional)
+//   mason_min = 0.5                       # matches mason >= mason_min (optional)
+//   models = ["dem_stokes"]               # matches these models (optional)
+//   set = ["drive.strain=3"]
+// Errors are InputErrors naming the key and FILE:LINE.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "mrf/io/atomic_file.hpp"
+
+namespace mrf {
+
+struct SweepRule {
+  double mason_min = 0, mason_max = 0;  // 0 = no bound
+  std::vector<std::string> models;      // empty = all
+  std::vector<std::string> set;
+};
+
+struct SweepSpec {
+  std::string source;      // sweep file path (for messages)
+  std::string scene_path;  // resolved base scene path
+  std::vector<std::string> models;
+  std::vector<double> mason;
+  std::vector<std::uint64_t> seeds;
+  std::vector<std::string> set;
+  std::vector<SweepRule> rules;
+};
+
+struct SweepPoint {
+  std::size_t index = 0;          // position in the grid (model-major, then mason, then seed)
+  std::string model;
+  double mason = 0;
+  std::uint64_t seed = 0;
+  std::vector<std::string> sets;  // every override of this point, in order
+  std::string dir;                // output folder relative to the sweep output, e.g. dem_stokes/mn_0.01_seed_1
+};
+
+SweepSpec load_sweep(const std::string& path);
+SweepSpec parse_sweep(const std::string& toml_text, const std::string& source, const std::string& base_dir);
+
+// The grid in a fixed order; every point carries scene.model, drive.mason
+// and scene.seed overrides after the sweep-wide and rule overrides.
+std::vector<SweepPoint> sweep_points(const SweepSpec& spec);
+
+// Indices of the points that rank `rank` of `size` runs (round-robin).
+std::vector<std::size_t> points_of_rank(std::size_t n_points, int rank, int size);
+
+// Rank and size from the MPI launcher's environment (Open MPI
+// OMPI_COMM_WORLD_RANK/SIZE, or PMI_RANK/PMI_SIZE); {0, 1} outside mpirun.
+struct RankInfo {
+  int rank = 0, size = 1;
+};
+RankInfo rank_from_environment();
+
+// A point is finished when its summary.json exists (written last, atomically).
+bool point_finished(const std::string& point_dir);
+
+// sweep.csv text: one row per point of `points` that has a summary.json or a
+// failure.json under `out_dir`, with the DESIGN.md summary fields.
+std::string sweep_csv(const std::vector<SweepPoint>& points, const std::string& out_dir);
+
+struct SweepOptions {
+  bool quiet = false;       // no progress on stderr
+  RankInfo rank;            // which share of the grid this process runs
+  double cost_rate = 1e6;   // particle-steps per second assumed by the first estimate
+};
+
+struct SweepOutcome {
+  std::size_t ran = 0, skipped = 0, failed = 0;
+  double estimated_seconds = 0;  // of this rank's unfinished points, before starting
+  double seconds = 0;            // wall time spent
+};
+
+// Estimated wall time (s) of one point: steps from the automatic time step,
+// times (free + wall [+ fluid]) particles, over `cost_rate`. NaN when the
+// time step cannot be estimated for the model.
+double estimate_point_seconds(const std::string& scene_path, const std::vector<std::string>& sets, double cost_rate);
+
+// Runs this rank's unfinished points one after another into out_dir/<point.dir>
+// (every scene is loaded and validated before the first run, so an input
+// error stops the sweep at once). A point that fails numerically leaves
+// failure.json with the message and the sweep goes on; a finished point is
+// skipped. Progress and an estimate of the time left go to stderr. At the
+// end out_dir/sweep.csv is rewritten (atomically) from every finished point.
+SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const SweepOptions& opt);
+
+}  // namespace mrf

@@ -1,0 +1,134 @@
+// The sweep driver: estimate, run the unfinished points of this rank, report
+// progress, collect sweep.csv.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <nlohmann/json.hpp>
+
+#include "mrf/error.hpp"
+#include "mrf/scene/dem_params.hpp"
+#include "mrf/scene/run.hpp"
+#include "mrf/study/sweep.hpp"
+#include "mrf/vec.hpp"
+
+namespace mrf {
+namespace {
+
+double estimate_seconds(const LoadedScene& scene, double cost_rate) {
+  const SceneConfig& c = scene.config;
+  const double volume = c.gap * c.ly * c.lz;
+  const double n_free = c.volume_fraction * volume / sphere_volume(c.radius);
+  if (n_free == 0) return std::numeric_limits<double>::quiet_NaN();
+  const DemParams p = dem_params(c);
+  const TimeStepChoice ts = choose_time_step(scene, p);
+  const double n_wall = c.wall_spacing > 0 ? 2.0 * (c.ly / c.wall_spacing) * (c.lz / c.wall_spacing) : 0.0;
+  double particles = n_free + n_wall;
+  if (c.model != ModelId::dem_stokes && c.sph_spacing > 0)
+    particles += volume / (c.sph_spacing * c.sph_spacing * c.sph_spacing);
+  const double steps = c.strain / (c.shear_rate * ts.dt);
+  return steps * particles / cost_rate;
+}
+
+std::string format_seconds(double s) {
+  char buf[32];
+  if (!std::isfinite(s)) return "unknown";
+  if (s < 120) std::snprintf(buf, sizeof buf, "%.0f s", s);
+  else if (s < 7200) std::snprintf(buf, sizeof buf, "%.1f min", s / 60);
+  else std::snprintf(buf, sizeof buf, "%.1f h", s / 3600);
+  return buf;
+}
+
+}  // namespace
+
+double estimate_point_seconds(const std::string& scene_path, const std::vector<std::string>& sets, double cost_rate) {
+  try {
+    return estimate_seconds(load_scene(scene_path, sets), cost_rate);
+  } catch (const InputError&) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+}
+
+SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const SweepOptions& opt) {
+  const std::vector<SweepPoint> points = sweep_points(spec);
+  const auto mine = points_of_rank(points.size(), opt.rank.rank, opt.rank.size);
+  SweepOutcome outcome;
+  struct Todo {
+    const SweepPoint* point;
+    LoadedScene scene;
+    double estimate;
+  };
+  std::vector<Todo> todo;
+  for (std::size_t i : mine) {
+    const SweepPoint& p = points[i];
+    if (point_finished((std::filesystem::path(out_dir) / p.dir).string())) {
+      ++outcome.skipped;
+      continue;
+    }
+    LoadedScene scene = load_scene(spec.scene_path, p.sets);  // input errors stop the sweep here
+    double est = std::numeric_limits<double>::quiet_NaN();
+    try {
+      est = estimate_seconds(scene, opt.cost_rate);
+    } catch (const InputError&) {
+      // not estimable (e.g. a time-step rule of a model the estimate does not know); run it anyway
+    }
+    todo.push_back({&p, std::move(scene), est});
+  }
+  double known = 0;
+  std::size_t unknown = 0;
+  for (const auto& t : todo) {
+    if (std::isfinite(t.estimate)) known += t.estimate;
+    else ++unknown;
+  }
+  outcome.estimated_seconds = known;
+  if (!opt.quiet)
+    std::fprintf(stderr,
+                 "mrf sweep: %zu points in the grid, rank %d of %d runs %zu (%zu already finished); "
+                 "estimated cost %s at %.3g particle-steps/s%s\n",
+                 points.size(), opt.rank.rank, opt.rank.size, mine.size(), outcome.skipped,
+                 format_seconds(known).c_str(), opt.cost_rate,
+                 unknown ? (" (+" + std::to_string(unknown) + " points not estimable)").c_str() : "");
+
+  const auto t0 = std::chrono::steady_clock::now();
+  double spent_estimated = 0, spent_actual = 0, left_estimated = known;
+  for (std::size_t k = 0; k < todo.size(); ++k) {
+    const Todo& t = todo[k];
+    const std::string dir = (std::filesystem::path(out_dir) / t.point->dir).string();
+    if (!opt.quiet)
+      std::fprintf(stderr, "mrf sweep: [%zu/%zu] %s Mn=%g seed %llu -> %s\n", k + 1, todo.size(),
+                   t.point->model.c_str(), t.point->mason, static_cast<unsigned long long>(t.point->seed), dir.c_str());
+    const auto p0 = std::chrono::steady_clock::now();
+    try {
+      const RunSummary s = run_scene(t.scene, {dir, true});
+      ++outcome.ran;
+      if (!opt.quiet)
+        std::fprintf(stderr, "           stress_total = %.5g +- %.2g Pa, drift z = %.2f\n", s.stress_total.mean,
+                     s.stress_total.err, s.stress_total.drift_z);
+    } catch (const std::runtime_error& e) {  // NumericalError, or an InputError only the run can see
+      ++outcome.failed;
+      std::filesystem::create_directories(dir);
+      nlohmann::json j{{"model", t.point->model}, {"mason", t.point->mason}, {"seed", t.point->seed},
+                       {"error", e.what()}};
+      write_file_atomic(dir + "/failure.json", j.dump(2) + "\n");
+      std::fprintf(stderr, "mrf sweep: point %s failed: %s\n", t.point->dir.c_str(), e.what());
+    }
+    const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - p0).count();
+    if (std::isfinite(t.estimate)) {
+      spent_estimated += t.estimate;
+      spent_actual += took;
+      left_estimated -= t.estimate;
+    }
+    if (!opt.quiet) {
+      const double scale = spent_estimated > 0 ? spent_actual / spent_estimated : 1.0;
+      std::fprintf(stderr, "           took %s; about %s left (estimate x %.2f measured so far)\n",
+                   format_seconds(took).c_str(), format_seconds(left_estimated * scale).c_str(), scale);
+    }
+  }
+  outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::filesystem::create_directories(out_dir);
+  write_file_atomic((std::filesystem::path(out_dir) / "sweep.csv").string(), sweep_csv(points, out_dir));
+  return outcome;
+}
+
+}  // namespace mrf

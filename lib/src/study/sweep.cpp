@@ -1,0 +1,236 @@
+#include "mrf/study/sweep.hpp"
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+
+#include "mrf/error.hpp"
+#include "mrf/io/atomic_file.hpp"
+#include "mrf/scene/config.hpp"
+
+namespace mrf {
+namespace {
+
+std::string where_of(const toml::node& n, const std::string& source) {
+  return source + ":" + std::to_string(n.source().begin.line);
+}
+
+std::string text_of(const toml::node& n) {
+  std::ostringstream os;
+  os << toml::toml_formatter{n};
+  return os.str();
+}
+
+const toml::array& need_array(const toml::table& t, const char* key, const std::string& section,
+                              const std::string& source) {
+  const toml::node* n = t.get(key);
+  if (!n) throw InputError(section + "." + key, "", source, "missing");
+  const toml::array* a = n->as_array();
+  if (!a || a->empty()) throw InputError(section + "." + key, text_of(*n), where_of(*n, source), "expected a non-empty array");
+  return *a;
+}
+
+std::vector<std::string> strings(const toml::array& a, const std::string& key, const std::string& source) {
+  std::vector<std::string> out;
+  for (const auto& e : a) {
+    const auto* s = e.as_string();
+    if (!s) throw InputError(key, text_of(e), where_of(e, source), "expected a string");
+    out.push_back(s->get());
+  }
+  return out;
+}
+
+void check_models(const std::vector<std::string>& models, const toml::node& n, const std::string& key,
+                  const std::string& source) {
+  for (const auto& m : models) {
+    bool known = false;
+    for (ModelId id : {ModelId::dem_stokes, ModelId::demsph_stokes, ModelId::demsph_dd}) known |= m == to_string(id);
+    if (!known)
+      throw InputError(key, "\"" + m + "\"", where_of(n, source),
+                       "unknown model; expected dem_stokes, demsph_stokes or demsph_dd");
+  }
+}
+
+double positive_number(const toml::node& n, const std::string& key, const std::string& source) {
+  const auto v = n.value<double>();
+  if (!v || !(*v > 0)) throw InputError(key, text_of(n), where_of(n, source), "expected a positive number");
+  return *v;
+}
+
+std::string mason_label(double mn) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", mn);
+  return buf;
+}
+
+}  // namespace
+
+SweepSpec parse_sweep(const std::string& toml_text, const std::string& source, const std::string& base_dir) {
+  toml::table root;
+  try {
+    root = toml::parse(toml_text, source);
+  } catch (const toml::parse_error& e) {
+    throw InputError("(syntax)", "", source + ":" + std::to_string(e.source().begin.line), std::string(e.description()));
+  }
+  for (const auto& [k, v] : root)
+    if (k.str() != "sweep" && k.str() != "rule")
+      throw InputError(std::string(k.str()), "", where_of(v, source), "unknown section; expected [sweep] or [[rule]]");
+  const toml::table* sw = root["sweep"].as_table();
+  if (!sw) throw InputError("sweep", "", source, "missing [sweep] table");
+  SweepSpec s;
+  s.source = source;
+  for (const auto& [k, v] : *sw) {
+    const std::string key(k.str());
+    if (key != "scene" && key != "models" && key != "mason" && key != "seeds" && key != "set")
+      throw InputError("sweep." + key, text_of(v), where_of(v, source), "unknown key");
+  }
+  const toml::node* scene = sw->get("scene");
+  if (!scene || !scene->is_string()) throw InputError("sweep.scene", "", source, "missing (path of the base scene)");
+  s.scene_path = (std::filesystem::path(base_dir) / scene->as_string()->get()).lexically_normal().string();
+  if (!std::filesystem::exists(s.scene_path))
+    throw InputError("sweep.scene", text_of(*scene), where_of(*scene, source), "no such file: " + s.scene_path);
+  const auto& models = need_array(*sw, "models", "sweep", source);
+  s.models = strings(models, "sweep.models", source);
+  check_models(s.models, models, "sweep.models", source);
+  for (const auto& e : need_array(*sw, "mason", "sweep", source)) s.mason.push_back(positive_number(e, "sweep.mason", source));
+  for (const auto& e : need_array(*sw, "seeds", "sweep", source)) {
+    const auto v = e.value<std::int64_t>();
+    if (!v || *v < 0) throw InputError("sweep.seeds", text_of(e), where_of(e, source), "expected a non-negative integer");
+    s.seeds.push_back(static_cast<std::uint64_t>(*v));
+  }
+  if (const auto* set = (*sw)["set"].as_array()) s.set = strings(*set, "sweep.set", source);
+  if (const toml::node* rules = root.get("rule")) {
+    const auto* arr = rules->as_array();
+    if (!arr) throw InputError("rule", "", where_of(*rules, source), "expected [[rule]] tables");
+    for (const auto& e : *arr) {
+      const auto* t = e.as_table();
+      if (!t) throw InputError("rule", text_of(e), where_of(e, source), "expected a table");
+      SweepRule r;
+      for (const auto& [k, v] : *t) {
+        const std::string key(k.str());
+        if (key == "mason_min") r.mason_min = positive_number(v, "rule.mason_min", source);
+        else if (key == "mason_max") r.mason_max = positive_number(v, "rule.mason_max", source);
+        else if (key == "models") {
+          const auto* a = v.as_array();
+          if (!a) throw InputError("rule.models", text_of(v), where_of(v, source), "expected an array of model names");
+          r.models = strings(*a, "rule.models", source);
+          check_models(r.models, v, "rule.models", source);
+        } else if (key == "set") {
+          const auto* a = v.as_array();
+          if (!a) throw InputError("rule.set", text_of(v), where_of(v, source), "expected an array of section.key=value");
+          r.set = strings(*a, "rule.set", source);
+        } else {
+          throw InputError("rule." + key, text_of(v), where_of(v, source), "unknown key");
+        }
+      }
+      if (r.set.empty()) throw InputError("rule.set", "", where_of(e, source), "a rule needs overrides to apply");
+      s.rules.push_back(std::move(r));
+    }
+  }
+  return s;
+}
+
+SweepSpec load_sweep(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError("sweep", path, "", "cannot open the sweep file");
+  std::stringstream text;
+  text << in.rdbuf();
+  return parse_sweep(text.str(), path, std::filesystem::path(path).parent_path().string());
+}
+
+std::vector<SweepPoint> sweep_points(const SweepSpec& spec) {
+  std::vector<SweepPoint> out;
+  for (const auto& model : spec.models)
+    for (double mn : spec.mason)
+      for (std::uint64_t seed : spec.seeds) {
+        SweepPoint p;
+        p.index = out.size();
+        p.model = model;
+        p.mason = mn;
+        p.seed = seed;
+        p.sets = spec.set;
+        for (const auto& r : spec.rules) {
+          const bool model_ok = r.models.empty() || std::find(r.models.begin(), r.models.end(), model) != r.models.end();
+          const bool mn_ok = (r.mason_min == 0 || mn >= r.mason_min) && (r.mason_max == 0 || mn <= r.mason_max);
+          if (model_ok && mn_ok) p.sets.insert(p.sets.end(), r.set.begin(), r.set.end());
+        }
+        p.sets.push_back("scene.model=\"" + model + "\"");
+        p.sets.push_back("drive.mason=" + mason_label(mn));
+        p.sets.push_back("scene.seed=" + std::to_string(seed));
+        p.dir = model + "/mn_" + mason_label(mn) + "_seed_" + std::to_string(seed);
+        out.push_back(std::move(p));
+      }
+  return out;
+}
+
+std::vector<std::size_t> points_of_rank(std::size_t n_points, int rank, int size) {
+  if (size < 1 || rank < 0 || rank >= size)
+    throw std::invalid_argument("points_of_rank: rank " + std::to_string(rank) + " of " + std::to_string(size));
+  std::vector<std::size_t> out;
+  for (std::size_t i = static_cast<std::size_t>(rank); i < n_points; i += static_cast<std::size_t>(size)) out.push_back(i);
+  return out;
+}
+
+RankInfo rank_from_environment() {
+  auto read = [](const char* a, const char* b) -> const char* {
+    if (const char* v = std::getenv(a)) return v;
+    return std::getenv(b);
+  };
+  const char* r = read("OMPI_COMM_WORLD_RANK", "PMI_RANK");
+  const char* n = read("OMPI_COMM_WORLD_SIZE", "PMI_SIZE");
+  RankInfo info;
+  if (r && n) {
+    info.rank = std::atoi(r);
+    info.size = std::atoi(n);
+    if (info.size < 1 || info.rank < 0 || info.rank >= info.size) info = RankInfo{};
+  }
+  return info;
+}
+
+bool point_finished(const std::string& point_dir) {
+  return std::filesystem::exists(std::filesystem::path(point_dir) / "summary.json");
+}
+
+std::string sweep_csv(const std::vector<SweepPoint>& points, const std::string& out_dir) {
+  static const char* numbers[] = {"shear_rate", "strain", "warmup_strain", "stress_total", "stress_total_err",
+                                  "stress_total_drift_z", "stress_particles", "stress_particles_err", "stress_fluid",
+                                  "stress_virial", "stress_virial_err", "stress_virial_magnetic",
+                                  "stress_virial_contact", "n_particles", "n_fluid", "dt", "steps", "wall_seconds",
+                                  "stokes_number", "reynolds_number", "max_overlap_over_radius", "volume_fraction",
+                                  "magnetization", "youngs_modulus"};
+  std::ostringstream csv;
+  csv.precision(10);
+  csv << "model,mason,seed,status";
+  for (const char* k : numbers) csv << "," << k;
+  csv << ",integrator,dir\n";
+  for (const auto& p : points) {
+    const auto dir = std::filesystem::path(out_dir) / p.dir;
+    nlohmann::json j;
+    std::string status;
+    if (std::ifstream in(dir / "summary.json"); in) {
+      j = nlohmann::json::parse(in, nullptr, false);
+      status = j.is_discarded() ? "unreadable" : "ok";
+    } else if (std::filesystem::exists(dir / "failure.json")) {
+      status = "failed";
+    } else {
+      continue;
+    }
+    csv << p.model << "," << p.mason << "," << p.seed << "," << status;
+    for (const char* k : numbers) {
+      csv << ",";
+      if (status == "ok" && j.contains(k) && j[k].is_number()) csv << j[k].get<double>();
+    }
+    csv << "," << (status == "ok" && j.contains("integrator") ? j["integrator"].get<std::string>() : "") << "," << p.dir
+        << "\n";
+  }
+  return csv.str();
+}
+
+}  // namespace mrf

@@ -1,0 +1,143 @@
+// `mrf sweep`: the grid, its overrides, the split across ranks, resuming a
+// killed sweep, and sweep.csv (issue 6).
+#include "mrf/study/sweep.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "mrf/error.hpp"
+
+namespace mrf {
+namespace {
+
+const std::string k_scenes = MRF_SOURCE_DIR "/experiments/scenes";
+
+std::string grid_text(const std::string& extra = "") {
+  return "[sweep]\n"
+         "scene = \"small_dem_stokes.toml\"\n"
+         "models = [\"dem_stokes\", \"demsph_dd\"]\n"
+         "mason = [1e-3, 0.01, 1.0]\n"
+         "seeds = [1, 2]\n"
+         "set = [\"drive.strain=4\"]\n" +
+         extra;
+}
+
+TEST(Sweep, GridIsModelMajorWithOverridesInOrder) {
+  const SweepSpec s = parse_sweep(grid_text("[[rule]]\nmason_max = 2e-3\nmodels = [\"dem_stokes\"]\n"
+                                            "set = [\"drive.strain=2\"]\n"),
+                                  "grid.toml", k_scenes);
+  const auto pts = sweep_points(s);
+  ASSERT_EQ(pts.size(), 2u * 3u * 2u);
+  EXPECT_EQ(pts[0].model, "dem_stokes");
+  EXPECT_EQ(pts[0].mason, 1e-3);
+  EXPECT_EQ(pts[1].seed, 2u);
+  EXPECT_EQ(pts[2].mason, 0.01);
+  EXPECT_EQ(pts[6].model, "demsph_dd");
+  EXPECT_EQ(pts[3].dir, "dem_stokes/mn_0.01_seed_2");
+  // the rule applies to dem_stokes at Mn <= 2e-3 only, after the sweep-wide set
+  const std::vector<std::string> first{"drive.strain=4", "drive.strain=2", "scene.model=\"dem_stokes\"",
+                                       "drive.mason=0.001", "scene.seed=1"};
+  EXPECT_EQ(pts[0].sets, first);
+  EXPECT_EQ(pts[2].sets.size(), 4u);
+  EXPECT_EQ(pts[6].sets.size(), 4u);  // demsph_dd at 1e-3: rule does not match the model
+  for (std::size_t i = 0; i < pts.size(); ++i) EXPECT_EQ(pts[i].index, i);
+}
+
+void expect_input_error(const std::string& text, const std::string& key, const std::string& where) {
+  try {
+    parse_sweep(text, "grid.toml", k_scenes);
+    FAIL() << "expected InputError for " << key;
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), key) << e.what();
+    EXPECT_NE(std::string(e.what()).find(where), std::string::npos) << e.what();
+  }
+}
+
+TEST(Sweep, BadInputNamesKeyAndLine) {
+  expect_input_error(grid_text("bogus = 1\n"), "sweep.bogus", "grid.toml:7");
+  expect_input_error(grid_text("[extra]\nx = 1\n"), "extra", "grid.toml:7");
+  std::string t = grid_text();
+  expect_input_error(t.replace(t.find("demsph_dd"), 9, "demsph_xx"), "sweep.models", "grid.toml:3");
+  t = grid_text();
+  expect_input_error(t.replace(t.find("1e-3"), 4, "-1e-3"), "sweep.mason", "grid.toml:4");
+  t = grid_text();
+  expect_input_error(t.replace(t.find("small_dem"), 9, "nothere_x"), "sweep.scene", "grid.toml:2");
+  expect_input_error(grid_text("[[rule]]\nmason_max = 1.0\n"), "rule.set", "grid.toml:7");
+  expect_input_error(grid_text("[[rule]]\nspeed = 1.0\nset = [\"a.b=1\"]\n"), "rule.speed", "grid.toml:8");
+}
+
+TEST(Sweep, RanksShareThePointsExactlyOnce) {
+  for (int size : {1, 2, 3, 7}) {
+    std::multiset<std::size_t> all;
+    for (int r = 0; r < size; ++r)
+      for (std::size_t i : points_of_rank(12, r, size)) all.insert(i);
+    ASSERT_EQ(all.size(), 12u) << size;
+    for (std::size_t i = 0; i < 12; ++i) EXPECT_EQ(all.count(i), 1u) << size;
+  }
+  EXPECT_THROW(points_of_rank(12, 2, 2), std::invalid_argument);
+}
+
+TEST(Sweep, RankFromOpenMpiEnvironment) {
+  ::setenv("OMPI_COMM_WORLD_RANK", "2", 1);
+  ::setenv("OMPI_COMM_WORLD_SIZE", "3", 1);
+  const RankInfo r = rank_from_environment();
+  EXPECT_EQ(r.rank, 2);
+  EXPECT_EQ(r.size, 3);
+  ::unsetenv("OMPI_COMM_WORLD_RANK");
+  ::unsetenv("OMPI_COMM_WORLD_SIZE");
+  const RankInfo none = rank_from_environment();
+  EXPECT_EQ(none.rank, 0);
+  EXPECT_EQ(none.size, 1);
+}
+
+nlohmann::json read_json(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  return nlohmann::json::parse(in);
+}
+
+// A short two-point sweep; "killing" it leaves one point without summary.json
+// (and a stale temporary file); the resumed sweep runs exactly that point and
+// reproduces it bit for bit.
+TEST(Sweep, KilledSweepResumesAndReproduces) {
+  const auto out = std::filesystem::temp_directory_path() / "mrf_test_sweep";
+  std::filesystem::remove_all(out);
+  const SweepSpec s = parse_sweep(
+      "[sweep]\nscene = \"small_dem_stokes.toml\"\nmodels = [\"dem_stokes\"]\nmason = [0.3, 1.0]\nseeds = [3]\n"
+      "set = [\"drive.strain=0.6\", \"drive.warmup_strain=0.2\"]\n",
+      "tiny.toml", k_scenes);
+  SweepOptions opt;
+  opt.quiet = true;
+  const SweepOutcome first = run_sweep(s, out.string(), opt);
+  EXPECT_EQ(first.ran, 2u);
+  EXPECT_EQ(first.failed, 0u);
+  const auto p1 = out / "dem_stokes/mn_1_seed_3";
+  const double stress = read_json(p1 / "summary.json")["stress_total"].get<double>();
+  std::filesystem::remove(p1 / "summary.json");
+  std::ofstream(p1 / "summary.json.tmp") << "{ \"half";
+  const SweepOutcome second = run_sweep(s, out.string(), opt);
+  EXPECT_EQ(second.ran, 1u);
+  EXPECT_EQ(second.skipped, 1u);
+  EXPECT_EQ(read_json(p1 / "summary.json")["stress_total"].get<double>(), stress);
+  std::ifstream csv(out / "sweep.csv");
+  std::string header, row;
+  std::getline(csv, header);
+  EXPECT_EQ(header.rfind("model,mason,seed,status,shear_rate", 0), 0u) << header;
+  int rows = 0;
+  while (std::getline(csv, row)) {
+    ++rows;
+    EXPECT_NE(row.find(",ok,"), std::string::npos) << row;
+  }
+  EXPECT_EQ(rows, 2);
+  const SweepOutcome third = run_sweep(s, out.string(), opt);
+  EXPECT_EQ(third.ran, 0u);
+  EXPECT_EQ(third.skipped, 2u);
+}
+
+}  // namespace
+}  // namespace mrf
