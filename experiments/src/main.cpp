@@ -1,11 +1,13 @@
 // The `mrf` command line (DESIGN.md §Interfaces).
 //   mrf run SCENE.toml [--set section.key=value]... [--out DIR] [--quiet]
+//   mrf criterion SWEEP_DIR|RUN_DIR [--thresholds FILE]
 //   mrf sweep SWEEP.toml [--out DIR] [--quiet] [--estimate]   (mpirun -n K splits the points)
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
 #include <filesystem>
 
+#include "criterion_command.hpp"
 #include "mrf/error.hpp"
 #include "mrf/io/lammps_data.hpp"
 #include "mrf/scene/run.hpp"
@@ -88,10 +90,17 @@ int main(int argc, char** argv) {
   sw->add_option("--out", sweep_out, "output directory (default out/sweeps/<sweep name>)");
   sw->add_flag("--quiet", sweep_quiet, "no progress on stderr");
   sw->add_flag("--estimate", sweep_estimate, "print the estimated cost of every point and stop");
+  auto* cr = app.add_subcommand("criterion", "flow-curve fits, deviation from model 3 and the model-1 verdict");
+  std::string cr_path, cr_thresholds;
+  cr->add_option("path", cr_path, "a sweep output directory (sweep.csv) or a dem_stokes run directory (summary.json)")
+      ->required();
+  cr->add_option("--thresholds", cr_thresholds,
+                 "JSON with share_10 and share_20 (e.g. experiments/criterion_thresholds.json) for verdicts");
   CLI11_PARSE(app, argc, argv);
   try {
     if (*run) return run_command(scene, sets, out, quiet);
     if (*exp) return export_lammps(exp_scene, exp_sets, exp_out);
+    if (*cr) return criterion_command(cr_path, cr_thresholds);
     if (*sw) return sweep_command(sweep_file, sweep_out, sweep_quiet, sweep_estimate);
   } catch (const mrf::InputError& e) {
     std::fprintf(stderr, "mrf: error: %s\n", e.what());

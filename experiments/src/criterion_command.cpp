@@ -1,0 +1,168 @@
+// `mrf criterion PATH`: flow-curve fits, deviations from model 3 and the
+// applicability verdict of model 1 for a sweep (PATH/sweep.csv) or a single
+// run (PATH/summary.json). See lib/include/mrf/study/criterion.hpp.
+#include "criterion_command.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+
+#include "mrf/error.hpp"
+#include "mrf/io/atomic_file.hpp"
+#include "mrf/study/criterion.hpp"
+
+namespace {
+
+using nlohmann::ordered_json;
+
+ordered_json fit_json(const mrf::FlowFit& f) {
+  return {{"ok", f.ok},
+          {"message", f.message},
+          {"eta_inf", f.eta_inf},
+          {"eta_inf_err", f.eta_inf_err},
+          {"mason_star", f.mason_star},
+          {"mason_star_err", f.mason_star_err},
+          {"exponent", f.exponent},
+          {"exponent_err", f.exponent_err},
+          {"chi2_dof", f.chi2_dof},
+          {"dof", f.dof}};
+}
+
+struct Thresholds {
+  double s10 = 0, s20 = 0;
+  std::string source;
+};
+
+Thresholds read_thresholds(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw mrf::InputError("--thresholds", path, "", "cannot open the thresholds file");
+  const auto j = nlohmann::json::parse(in);
+  return {j.at("share_10").get<double>(), j.at("share_20").get<double>(), path};
+}
+
+void print_verdict(const char* what, double share, const Thresholds& t) {
+  const auto v = mrf::apply_criterion(share, t.s10, t.s20);
+  std::printf("%s: hydrodynamic share s = tau_fluid/tau_total = %.3g -> model 1 %s within 10 %% (s < %.3g), %s within 20 %% "
+              "(s < %.3g) [thresholds from %s]\n",
+              what, share, v.adequate_10 ? "ADEQUATE" : "NOT adequate", t.s10, v.adequate_20 ? "ADEQUATE" : "NOT adequate",
+              t.s20, t.source.c_str());
+}
+
+int run_directory(const std::string& dir, const Thresholds* t) {
+  std::ifstream in(dir + "/summary.json");
+  const auto j = nlohmann::json::parse(in);
+  if (j.at("model") != "dem_stokes")
+    throw mrf::InputError("model", j.at("model").dump(), dir + "/summary.json",
+                          "the criterion is read off a model-1 (dem_stokes) run");
+  const double share = j.at("stress_fluid").get<double>() / j.at("stress_total").get<double>();
+  if (!t) {
+    std::printf("%s: hydrodynamic share s = %.3g (give --thresholds FILE for a verdict)\n", dir.c_str(), share);
+    return 0;
+  }
+  print_verdict(dir.c_str(), share, *t);
+  return 0;
+}
+
+}  // namespace
+
+int criterion_command(const std::string& path, const std::string& thresholds_path) {
+  std::optional<Thresholds> t;
+  if (!thresholds_path.empty()) t = read_thresholds(thresholds_path);
+  if (std::filesystem::exists(path + "/summary.json") && !std::filesystem::exists(path + "/sweep.csv"))
+    return run_directory(path, t ? &*t : nullptr);
+  const mrf::SweepTable table = mrf::read_sweep_csv(path + "/sweep.csv");
+  ordered_json out;
+  out["mason_convention"] = "Mn = 9 eta gdot / (2 mu0 M^2)";
+  out["magnetization"] = table.magnetization;
+  out["viscosity"] = table.viscosity;
+  out["volume_fraction"] = table.volume_fraction;
+  std::map<std::string, std::vector<mrf::FlowPoint>> curves;
+  for (const auto& [model, samples] : table.samples) {
+    const auto pts = mrf::seed_average(samples);
+    curves[model] = pts;
+    std::vector<double> mn, er, ee;
+    ordered_json rows = ordered_json::array();
+    for (const auto& p : pts) {
+      const double k = mrf::relative_viscosity(1.0, p.mason, table.viscosity, table.magnetization);
+      mn.push_back(p.mason);
+      er.push_back(p.stress * k);
+      ee.push_back(std::max(p.err, 1e-12 * std::abs(p.stress)) * k);
+      rows.push_back({{"mason", p.mason}, {"stress", p.stress}, {"err", p.err}, {"seed_scatter", p.seed_scatter},
+                      {"within_err", p.within_err}, {"seeds", p.seeds}, {"stress_fluid", p.stress_fluid},
+                      {"eta_r", er.back()}, {"eta_r_err", ee.back()}});
+    }
+    const auto bingham = mrf::fit_bingham(mn, er, ee);
+    const auto power = mrf::fit_power_law(mn, er, ee);
+    out["models"][model] = {{"points", rows}, {"bingham", fit_json(bingham)}, {"power_law", fit_json(power)}};
+    std::printf("%-14s Bingham: eta_inf = %.3g +- %.2g, Mn* = %.3g +- %.2g (chi2/dof %.2g)%s\n", model.c_str(),
+                bingham.eta_inf, bingham.eta_inf_err, bingham.mason_star, bingham.mason_star_err, bingham.chi2_dof,
+                bingham.ok ? "" : (" [" + bingham.message + "]").c_str());
+    std::printf("%-14s power law: eta_inf = %.3g +- %.2g, Mn* = %.3g +- %.2g, Delta = %.3f +- %.3f (chi2/dof %.2g)%s\n",
+                "", power.eta_inf, power.eta_inf_err, power.mason_star, power.mason_star_err, power.exponent,
+                power.exponent_err, power.chi2_dof, power.ok ? "" : (" [" + power.message + "]").c_str());
+  }
+  const bool have_ref = curves.count("demsph_dd") > 0;
+  for (const char* m : {"dem_stokes", "demsph_stokes"}) {
+    if (!have_ref || !curves.count(m)) continue;
+    const auto dev = mrf::deviation(curves[m], curves["demsph_dd"]);
+    ordered_json rows = ordered_json::array();
+    for (const auto& d : dev)
+      rows.push_back({{"mason", d.mason}, {"deviation", d.value}, {"err", d.err}, {"share", d.share}});
+    out["deviation_from_demsph_dd"][m]["points"] = rows;
+    for (double level : {0.1, 0.2}) {
+      const auto c = mrf::first_crossing(dev, level);
+      const std::string key = level == 0.1 ? "crossing_10" : "crossing_20";
+      out["deviation_from_demsph_dd"][m][key] = {{"found", c.found}, {"mason", c.mason}, {"share", c.share}};
+      if (c.found)
+        std::printf("%-14s departs from demsph_dd by %2.0f %% at Mn = %.3g (hydrodynamic share s = %.3g)\n", m,
+                    100 * level, c.mason, c.share);
+      else
+        std::printf("%-14s stays within %2.0f %% of demsph_dd over the sweep\n", m, 100 * level);
+    }
+  }
+  if (have_ref && curves.count("dem_stokes")) {
+    const auto& d = out["deviation_from_demsph_dd"]["dem_stokes"];
+    if (d["crossing_10"]["found"] && d["crossing_20"]["found"])
+      out["derived_thresholds"] = {{"share_10", d["crossing_10"]["share"]}, {"share_20", d["crossing_20"]["share"]},
+                                   {"mason_10", d["crossing_10"]["mason"]}, {"mason_20", d["crossing_20"]["mason"]}};
+  }
+  if (t && curves.count("dem_stokes")) {
+    // verdict per model-1 point, and where model 3 was run too, the hit rate
+    int hits = 0, tested = 0;
+    const auto pts = curves["dem_stokes"];
+    std::vector<mrf::Deviation> dev;
+    if (have_ref) dev = mrf::deviation(pts, curves["demsph_dd"]);
+    ordered_json rows = ordered_json::array();
+    for (const auto& p : pts) {
+      const double share = p.stress_fluid / p.stress;
+      const auto v = mrf::apply_criterion(share, t->s10, t->s20);
+      ordered_json r{{"mason", p.mason}, {"share", share}, {"adequate_10", v.adequate_10}, {"adequate_20", v.adequate_20}};
+      for (const auto& d : dev)
+        if (d.mason == p.mason) {
+          const bool ok10 = std::abs(d.value) < 0.1, ok20 = std::abs(d.value) < 0.2;
+          r["deviation"] = d.value;
+          r["hit_10"] = ok10 == v.adequate_10;
+          r["hit_20"] = ok20 == v.adequate_20;
+          hits += (ok10 == v.adequate_10) + (ok20 == v.adequate_20);
+          tested += 2;
+        }
+      rows.push_back(r);
+      char what[64];
+      std::snprintf(what, sizeof what, "Mn = %.3g", p.mason);
+      print_verdict(what, share, *t);
+    }
+    out["verdicts"] = {{"thresholds", t->source}, {"share_10", t->s10}, {"share_20", t->s20}, {"points", rows}};
+    if (tested) {
+      out["verdicts"]["hit_rate"] = static_cast<double>(hits) / tested;
+      std::printf("criterion hit rate on this sweep: %d of %d verdicts (10 %% and 20 %%) agree with model 3\n", hits,
+                  tested);
+    }
+  }
+  mrf::write_file_atomic(path + "/criterion.json", out.dump(2) + "\n");
+  std::printf("-> %s/criterion.json\n", path.c_str());
+  return 0;
+}

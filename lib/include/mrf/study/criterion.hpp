@@ -1,0 +1,48 @@
+// The applicability criterion of model 1 (issue 6): where the one-way
+// DEM-Stokes stress departs from the two-way DEM-SPH-DD stress, expressed
+// through a number a modeller can read off a single model-1 run: the
+// hydrodynamic share s = tau_fluid / tau_total (= eta gdot / tau for the
+// imposed Couette flow). Model 1 is called adequate at accuracy a where
+// s < s_a, s_a being the share at which |tau_1/tau_3 - 1| first reaches a
+// (interpolated in log Mn between sweep points).
+#pragma once
+#include <map>
+#include <string>
+#include <vector>
+
+#include "mrf/study/flow_curve.hpp"
+
+namespace mrf {
+
+// sweep.csv rows with status ok, grouped by model (magnetization and
+// viscosity taken from the rows; all rows of a sweep share them).
+struct SweepTable {
+  std::map<std::string, std::vector<StressSample>> samples;  // by model
+  double magnetization = 0, viscosity = 0, volume_fraction = 0;
+};
+SweepTable read_sweep_csv(const std::string& path);
+
+struct Deviation {
+  double mason = 0;
+  double value = 0, err = 0;  // tau_m / tau_ref - 1 and its standard error
+  double share = 0;           // hydrodynamic share of model m, tau_fluid / tau_total
+};
+
+// tau_m/tau_ref - 1 at the Mason numbers both flow curves have.
+std::vector<Deviation> deviation(const std::vector<FlowPoint>& model, const std::vector<FlowPoint>& ref);
+
+struct Crossing {
+  bool found = false;
+  double mason = 0;  // first Mn (from below) where |deviation| reaches the level, log-interpolated
+  double share = 0;  // hydrodynamic share there, interpolated the same way
+};
+Crossing first_crossing(const std::vector<Deviation>& d, double level);
+
+struct CriterionVerdict {
+  double share = 0;
+  bool adequate_10 = false, adequate_20 = false;
+};
+// s_10, s_20: the thresholds derived from a reference sweep.
+CriterionVerdict apply_criterion(double share, double s10, double s20);
+
+}  // namespace mrf

@@ -1,0 +1,98 @@
+#include "mrf/study/criterion.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "mrf/error.hpp"
+
+namespace mrf {
+
+namespace {
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream ss(line);
+  std::string cell;
+  while (std::getline(ss, cell, ',')) out.push_back(cell);
+  if (!line.empty() && line.back() == ',') out.emplace_back();
+  return out;
+}
+}  // namespace
+
+SweepTable read_sweep_csv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError("sweep.csv", path, "", "cannot open");
+  std::string line;
+  std::getline(in, line);
+  const auto header = split(line);
+  std::map<std::string, std::size_t> col;
+  for (std::size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
+  for (const char* k : {"model", "mason", "seed", "status", "stress_total", "stress_total_err", "stress_fluid",
+                        "magnetization", "volume_fraction"})
+    if (!col.count(k)) throw InputError("sweep.csv", path, "", std::string("missing column ") + k);
+  SweepTable t;
+  int line_no = 1;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const auto c = split(line);
+    if (c.size() != header.size())
+      throw InputError("sweep.csv", path + ":" + std::to_string(line_no), "", "row has a different column count");
+    if (c[col["status"]] != "ok") continue;
+    StressSample s;
+    s.mason = std::stod(c[col["mason"]]);
+    s.seed = std::stoull(c[col["seed"]]);
+    s.stress = std::stod(c[col["stress_total"]]);
+    s.err = std::stod(c[col["stress_total_err"]]);
+    s.stress_fluid = std::stod(c[col["stress_fluid"]]);
+    t.magnetization = std::stod(c[col["magnetization"]]);
+    t.volume_fraction = std::stod(c[col["volume_fraction"]]);
+    // eta from the first row: tau_fluid of model 1 is eta gdot, and gdot follows from Mn
+    if (t.viscosity == 0 && c[col["model"]] == "dem_stokes" && col.count("shear_rate"))
+      t.viscosity = s.stress_fluid / std::stod(c[col["shear_rate"]]);
+    t.samples[c[col["model"]]].push_back(s);
+  }
+  return t;
+}
+
+std::vector<Deviation> deviation(const std::vector<FlowPoint>& model, const std::vector<FlowPoint>& ref) {
+  std::vector<Deviation> out;
+  for (const auto& m : model)
+    for (const auto& r : ref)
+      if (m.mason == r.mason && r.stress != 0 && m.stress != 0) {
+        Deviation d;
+        d.mason = m.mason;
+        const double q = m.stress / r.stress;
+        d.value = q - 1.0;
+        d.err = std::abs(q) * std::sqrt(std::pow(m.err / m.stress, 2) + std::pow(r.err / r.stress, 2));
+        d.share = m.stress_fluid / m.stress;
+        out.push_back(d);
+      }
+  return out;
+}
+
+Crossing first_crossing(const std::vector<Deviation>& d, double level) {
+  Crossing c;
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    const double a = std::abs(d[i].value);
+    if (a < level) continue;
+    c.found = true;
+    if (i == 0) {  // already above at the lowest Mn: the crossing lies below the sweep
+      c.mason = d[0].mason;
+      c.share = d[0].share;
+      return c;
+    }
+    const double a0 = std::abs(d[i - 1].value);
+    const double w = (level - a0) / (a - a0);
+    c.mason = std::exp(std::log(d[i - 1].mason) + w * (std::log(d[i].mason) - std::log(d[i - 1].mason)));
+    c.share = d[i - 1].share + w * (d[i].share - d[i - 1].share);
+    return c;
+  }
+  return c;
+}
+
+CriterionVerdict apply_criterion(double share, double s10, double s20) {
+  return {share, share < s10, share < s20};
+}
+
+}  // namespace mrf

@@ -1,0 +1,76 @@
+// The model-1 applicability criterion on constructed flow curves with a known
+// deviation, and the sweep.csv reader.
+#include "mrf/study/criterion.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+namespace mrf {
+namespace {
+
+// Model 3 = model 1 with its hydrodynamic part scaled by k: tau3 = tau_mag + k eta gdot,
+// so tau1/tau3 - 1 = (1 - k) s / (1 + (k - 1) s) with s the share of model 1.
+std::vector<FlowPoint> curve(double k) {
+  std::vector<FlowPoint> out;
+  for (double lm = -4; lm <= 0.01; lm += 1) {
+    const double mn = std::pow(10.0, lm), fluid = 1e4 * mn, mag = 1e3 * std::pow(mn, 0.2);
+    FlowPoint p;
+    p.mason = mn;
+    p.stress = mag + k * fluid;
+    p.stress_fluid = k * fluid;
+    p.err = 0.01 * p.stress;
+    out.push_back(p);
+  }
+  return out;
+}
+
+TEST(Criterion, DeviationAndShareFollowTheConstruction) {
+  const auto m1 = curve(1.0), m3 = curve(2.5);
+  const auto d = deviation(m1, m3);
+  ASSERT_EQ(d.size(), 5u);
+  for (const auto& x : d) {
+    const double s = x.share;
+    EXPECT_NEAR(x.value, -1.5 * s / (1 + 1.5 * s), 1e-12);
+    EXPECT_NEAR(x.err, (1 + x.value) * 0.01 * std::sqrt(2.0), 1e-12);
+  }
+  EXPECT_LT(d.front().share, 0.01);
+  EXPECT_GT(d.back().share, 0.9);
+}
+
+TEST(Criterion, CrossingIsInterpolatedInLogMason) {
+  std::vector<Deviation> d{{1e-3, -0.05, 0, 0.1}, {1e-2, -0.15, 0, 0.3}, {1e-1, -0.5, 0, 0.8}};
+  const Crossing c10 = first_crossing(d, 0.1);
+  ASSERT_TRUE(c10.found);
+  EXPECT_NEAR(c10.mason, std::sqrt(1e-3 * 1e-2), 1e-15);  // halfway in log Mn
+  EXPECT_NEAR(c10.share, 0.2, 1e-12);
+  const Crossing c20 = first_crossing(d, 0.2);
+  EXPECT_NEAR(std::log10(c20.mason), -2 + 0.05 / 0.35, 1e-12);
+  EXPECT_FALSE(first_crossing(d, 0.6).found);
+  const Crossing below = first_crossing(d, 0.01);  // above the level at the first point
+  EXPECT_TRUE(below.found);
+  EXPECT_EQ(below.mason, 1e-3);
+  EXPECT_TRUE(apply_criterion(0.19, 0.2, 0.4).adequate_10);
+  EXPECT_FALSE(apply_criterion(0.21, 0.2, 0.4).adequate_10);
+  EXPECT_TRUE(apply_criterion(0.21, 0.2, 0.4).adequate_20);
+}
+
+TEST(Criterion, ReadsSweepCsvSkippingFailedPoints) {
+  const auto p = std::filesystem::temp_directory_path() / "mrf_test_sweep.csv";
+  std::ofstream(p) << "model,mason,seed,status,shear_rate,stress_total,stress_total_err,stress_fluid,magnetization,"
+                      "volume_fraction,dir\n"
+                      "dem_stokes,0.01,1,ok,100,50,1,10,1000000,0.3,a\n"
+                      "dem_stokes,0.01,2,failed,,,,,,,b\n"
+                      "demsph_dd,0.01,1,ok,100,60,2,20,1000000,0.3,c\n";
+  const SweepTable t = read_sweep_csv(p.string());
+  ASSERT_EQ(t.samples.at("dem_stokes").size(), 1u);
+  ASSERT_EQ(t.samples.at("demsph_dd").size(), 1u);
+  EXPECT_DOUBLE_EQ(t.viscosity, 0.1);
+  EXPECT_DOUBLE_EQ(t.magnetization, 1e6);
+  EXPECT_DOUBLE_EQ(t.samples.at("demsph_dd")[0].stress_fluid, 20);
+}
+
+}  // namespace
+}  // namespace mrf
