@@ -1,5 +1,5 @@
 // The `mrf` command line (DESIGN.md §Interfaces).
-//   mrf run SCENE.toml [--set section.key=value]... [--out DIR] [--quiet]
+//   mrf run SCENE.toml [--set section.key=value]... [--out DIR] [--quiet] [--resume] [--checkpoint-every S]
 //   mrf criterion SWEEP_DIR|RUN_DIR [--thresholds FILE]
 //   mrf sweep SWEEP.toml [--out DIR] [--quiet] [--estimate]   (mpirun -n K splits the points)
 #include <CLI/CLI.hpp>
@@ -15,11 +15,16 @@
 
 namespace {
 
-int run_command(const std::string& scene_path, const std::vector<std::string>& sets,
-                std::string out, bool quiet) {
+int run_command(const std::string& scene_path, const std::vector<std::string>& sets, std::string out, bool quiet,
+                bool resume, double checkpoint_seconds) {
   const mrf::LoadedScene scene = mrf::load_scene(scene_path, sets);
   if (out.empty()) out = "out/" + std::filesystem::path(scene_path).stem().string();
-  const mrf::RunSummary s = mrf::run_scene(scene, {out, quiet});
+  mrf::RunOptions opt;
+  opt.out_dir = out;
+  opt.quiet = quiet;
+  opt.resume = resume;
+  opt.checkpoint_seconds = checkpoint_seconds;
+  const mrf::RunSummary s = mrf::run_scene(scene, opt);
   std::printf("%s Mn=%.4g: stress_total = %.6g +- %.2g Pa (particles %.6g, fluid %.6g, virial %.6g +- %.2g), "
               "drift z = %.2f; %ld steps, %.1f s -> %s/summary.json\n",
               s.model.c_str(), s.mason, s.stress_total.mean, s.stress_total.err,
@@ -77,6 +82,10 @@ int main(int argc, char** argv) {
   run->add_option("--set", sets, "override one key: section.key=value (repeatable)");
   run->add_option("--out", out, "output directory (default out/<scene name>)");
   run->add_flag("--quiet", quiet, "no start-up table or progress on stderr");
+  bool resume = false;
+  double checkpoint_seconds = 60;
+  run->add_flag("--resume", resume, "continue from OUT/checkpoint.bin if it exists (same scene and overrides)");
+  run->add_option("--checkpoint-every", checkpoint_seconds, "wall seconds between checkpoints (0 = none)")->capture_default_str();
   auto* exp = app.add_subcommand("export-lammps", "write the scene's initial configuration as a LAMMPS data file");
   std::string exp_scene, exp_out;
   std::vector<std::string> exp_sets;
@@ -98,7 +107,7 @@ int main(int argc, char** argv) {
                  "JSON with share_10 and share_20 (e.g. experiments/criterion_thresholds.json) for verdicts");
   CLI11_PARSE(app, argc, argv);
   try {
-    if (*run) return run_command(scene, sets, out, quiet);
+    if (*run) return run_command(scene, sets, out, quiet, resume, checkpoint_seconds);
     if (*exp) return export_lammps(exp_scene, exp_sets, exp_out);
     if (*cr) return criterion_command(cr_path, cr_thresholds);
     if (*sw) return sweep_command(sweep_file, sweep_out, sweep_quiet, sweep_estimate);

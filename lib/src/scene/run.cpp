@@ -12,6 +12,7 @@
 #include "mrf/error.hpp"
 #include "mrf/fluid/couette_sph.hpp"
 #include "mrf/forces/drag.hpp"
+#include "mrf/io/archive.hpp"
 #include "mrf/io/atomic_file.hpp"
 #include "mrf/observe/block_average.hpp"
 #include "mrf/observe/stress.hpp"
@@ -88,6 +89,50 @@ struct Row {
 struct Series {
   std::vector<double> total, particles, virial, mag, con, diff;
 };
+
+// What the DEM run loop carries from one row to the next (checkpointed).
+struct LoopState {
+  long n = 0;                 // last completed step
+  Series se;
+  double max_overlap = 0;
+  long pair_evals = 0;
+  double elapsed_before = 0;  // wall seconds of earlier sessions of this run
+  std::uint64_t ts_bytes = 0, frames_bytes = 0;
+  void save(ArchiveWriter& a) const {
+    a.put(n);
+    for (const auto* v : {&se.total, &se.particles, &se.virial, &se.mag, &se.con, &se.diff}) a.put(*v);
+    a.put(max_overlap);
+    a.put(pair_evals);
+    a.put(elapsed_before);
+    a.put(ts_bytes);
+    a.put(frames_bytes);
+  }
+  void load(ArchiveReader& a) {
+    a.get(n);
+    for (auto* v : {&se.total, &se.particles, &se.virial, &se.mag, &se.con, &se.diff}) a.get(*v);
+    a.get(max_overlap);
+    a.get(pair_evals);
+    a.get(elapsed_before);
+    a.get(ts_bytes);
+    a.get(frames_bytes);
+  }
+};
+
+// Every parameter of the scene, exactly: a checkpoint resumes only into the same run.
+std::string scene_fingerprint(const SceneConfig& c) {
+  std::string out;
+  char buf[64];
+  for (double v : {c.gap, c.ly, c.lz, c.radius, c.volume_fraction, c.density, c.magnetization, c.dipole_cutoff,
+                   c.wall_spacing, c.youngs_modulus, c.poisson_ratio, c.viscosity, c.fluid_density, c.sph_spacing,
+                   c.sound_speed, c.mason, c.shear_rate, c.strain, c.warmup_strain, c.dt.value_or(-1.0), c.skin,
+                   c.dt_safety}) {
+    std::snprintf(buf, sizeof buf, "%a;", v);
+    out += buf;
+  }
+  out += std::string(to_string(c.model)) + ";" + to_string(c.integrator) + ";" + std::to_string(c.seed) + ";" +
+         std::to_string(c.threads) + ";" + std::to_string(c.every) + ";" + std::to_string(c.frames);
+  return out;
+}
 
 Measurement measure(const std::vector<double>& v) {
   const BlockAverage b = block_average(v);
@@ -204,66 +249,119 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
                      "leaves only " + std::to_string(static_cast<long>(rows_after_warmup)) +
                          " time-series rows after the warm-up; block averaging needs at least 32");
   const long frame_every = c.frames > 0 ? std::max(1L, s.steps / c.frames) : 0;
+  const std::string checkpoint = opt.out_dir.empty() ? "" : opt.out_dir + "/checkpoint.bin";
+  const std::string fingerprint = scene_fingerprint(c);
+  LoopState st;
+  bool resumed = false;
+  if (opt.resume && !checkpoint.empty() && std::filesystem::exists(checkpoint)) {
+    ArchiveReader in(checkpoint);
+    std::string fp;
+    in.get(fp);
+    if (fp != fingerprint)
+      throw InputError("--resume", checkpoint, "",
+                       "the checkpoint was written by a run with different scene parameters; remove it or use "
+                       "another --out");
+    st.load(in);
+    model.load(in);
+    resumed = true;
+    if (!opt.quiet)
+      std::fprintf(stderr, "  resuming from %s at step %ld (strain %.4g)\n", checkpoint.c_str(), st.n,
+                   model.time() * c.shear_rate);
+  }
   std::ofstream ts_out, frames_out;
   if (!opt.out_dir.empty()) {
     std::filesystem::create_directories(opt.out_dir);
-    ts_out.open(opt.out_dir + "/timeseries.csv");
+    if (resumed) {  // drop rows written after the checkpoint, then append
+      std::filesystem::resize_file(opt.out_dir + "/timeseries.csv", st.ts_bytes);
+      ts_out.open(opt.out_dir + "/timeseries.csv", std::ios::app);
+    } else {
+      ts_out.open(opt.out_dir + "/timeseries.csv");
+      ts_out << "time_s,strain,stress_total_Pa,stress_particles_Pa,stress_fluid_Pa,"
+                "stress_virial_magnetic_Pa,stress_virial_contact_Pa,max_overlap_over_radius,"
+                "energy_dipole_J,energy_hertz_J\n";
+    }
     ts_out.precision(10);
-    ts_out << "time_s,strain,stress_total_Pa,stress_particles_Pa,stress_fluid_Pa,"
-              "stress_virial_magnetic_Pa,stress_virial_contact_Pa,max_overlap_over_radius,"
-              "energy_dipole_J,energy_hertz_J\n";
-    if (frame_every > 0) frames_out.open(opt.out_dir + "/frames.xyz");
+    if (frame_every > 0) {
+      if (resumed) std::filesystem::resize_file(opt.out_dir + "/frames.xyz", st.frames_bytes);
+      frames_out.open(opt.out_dir + "/frames.xyz", resumed ? std::ios::app : std::ios::out);
+    }
   }
-  Series se;
   Row row;
-  double max_overlap = 0;
-  long pair_evals = 0;
   const auto t0 = std::chrono::steady_clock::now();
-  auto last_report = t0;
-  for (long n = 1; n <= s.steps; ++n) {
+  auto last_report = t0, last_checkpoint = t0;
+  long rows_since_checkpoint = 0;
+  for (long n = st.n + 1; n <= s.steps; ++n) {
     model.step();
     row.add(model.sums(), model.cell().box);
-    pair_evals += model.sums().pair_evaluations;
+    st.pair_evals += model.sums().pair_evaluations;
     if (frame_every > 0 && n % frame_every == 0 && frames_out) write_frame(frames_out, model.cell(), p.radius, model.time());
     if (n % every != 0 && n != s.steps) continue;
     const double k = 1.0 / row.n, strain = model.time() * c.shear_rate;
     const double tp = row.tau_p * k, vm = row.vir_mag * k, vc = row.vir_con * k;
-    max_overlap = std::max(max_overlap, row.max_overlap);
+    st.max_overlap = std::max(st.max_overlap, row.max_overlap);
     if (ts_out)
       ts_out << model.time() << "," << strain << "," << tp + s.stress_fluid << "," << tp << ","
              << s.stress_fluid << "," << vm << "," << vc << "," << row.max_overlap / p.radius << ","
              << row.e_dip * k << "," << row.e_hertz * k << "\n";
     if (strain - row.n * ts.dt * c.shear_rate >= c.warmup_strain) {  // whole row after warm-up
-      se.total.push_back(tp + s.stress_fluid);
-      se.particles.push_back(tp);
-      se.virial.push_back(vm + vc);
-      se.mag.push_back(vm);
-      se.con.push_back(vc);
-      se.diff.push_back(tp - vm - vc);
+      st.se.total.push_back(tp + s.stress_fluid);
+      st.se.particles.push_back(tp);
+      st.se.virial.push_back(vm + vc);
+      st.se.mag.push_back(vm);
+      st.se.con.push_back(vc);
+      st.se.diff.push_back(tp - vm - vc);
     }
     row = Row{};
     const auto now = std::chrono::steady_clock::now();
+    ++rows_since_checkpoint;
+    const bool due = opt.checkpoint_every_rows > 0
+                         ? rows_since_checkpoint >= opt.checkpoint_every_rows
+                         : opt.checkpoint_seconds > 0 &&
+                               std::chrono::duration<double>(now - last_checkpoint).count() > opt.checkpoint_seconds;
+    if (!checkpoint.empty() && due && n < s.steps) {
+      LoopState snap = st;
+      snap.n = n;
+      snap.elapsed_before += std::chrono::duration<double>(now - t0).count();
+      ts_out.flush();
+      snap.ts_bytes = static_cast<std::uint64_t>(std::filesystem::file_size(opt.out_dir + "/timeseries.csv"));
+      if (frames_out) {
+        frames_out.flush();
+        snap.frames_bytes = static_cast<std::uint64_t>(std::filesystem::file_size(opt.out_dir + "/frames.xyz"));
+      }
+      ArchiveWriter out(checkpoint + ".tmp");
+      out.put(fingerprint);
+      snap.save(out);
+      model.save(out);
+      out.close();
+      std::filesystem::rename(checkpoint + ".tmp", checkpoint);
+      last_checkpoint = now;
+      rows_since_checkpoint = 0;
+    }
+    if (opt.stop_after_steps > 0 && n >= opt.stop_after_steps) throw RunInterrupted(n);
     if (!opt.quiet && std::chrono::duration<double>(now - last_report).count() > 2.0) {
       last_report = now;
       const double el = std::chrono::duration<double>(now - t0).count();
-      std::fprintf(stderr, "\r  strain %.3f / %.3f  %.3g steps/s  ETA %.0f s   ", strain, c.strain,
-                   static_cast<double>(n) / el,
-                   el * static_cast<double>(s.steps - n) / static_cast<double>(n));
+      const double done = static_cast<double>(n - st.n);
+      std::fprintf(stderr, "\r  strain %.3f / %.3f  %.3g steps/s  ETA %.0f s   ", strain, c.strain, done / el,
+                   el * static_cast<double>(s.steps - n) / done);
     }
   }
-  s.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  s.wall_seconds = st.elapsed_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (!opt.quiet) std::fprintf(stderr, "\r  done: %ld steps in %.1f s%30s\n", s.steps, s.wall_seconds, "");
-  s.stress_total = measure(se.total);
-  s.stress_particles = measure(se.particles);
-  s.stress_virial = measure(se.virial);
-  s.stress_virial_magnetic = measure(se.mag);
-  s.stress_virial_contact = measure(se.con);
-  s.wall_minus_virial = measure(se.diff);
-  s.max_overlap_over_radius = max_overlap / p.radius;
+  s.stress_total = measure(st.se.total);
+  s.stress_particles = measure(st.se.particles);
+  s.stress_virial = measure(st.se.virial);
+  s.stress_virial_magnetic = measure(st.se.mag);
+  s.stress_virial_contact = measure(st.se.con);
+  s.wall_minus_virial = measure(st.se.diff);
+  s.max_overlap_over_radius = st.max_overlap / p.radius;
   s.neighbor_builds = model.lists().builds;
   s.particle_steps_per_second = static_cast<double>(s.n_particles * s.steps) / s.wall_seconds;
-  s.pair_evaluations_per_second = static_cast<double>(pair_evals) / s.wall_seconds;
-  if (!opt.out_dir.empty()) write_file_atomic(opt.out_dir + "/summary.json", summary_json(s) + "\n");
+  s.pair_evaluations_per_second = static_cast<double>(st.pair_evals) / s.wall_seconds;
+  if (!opt.out_dir.empty()) {
+    write_file_atomic(opt.out_dir + "/summary.json", summary_json(s) + "\n");
+    std::filesystem::remove(checkpoint);  // the run is complete; summary.json is its record
+  }
   return s;
 }
 

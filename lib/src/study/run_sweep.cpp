@@ -100,7 +100,11 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
                    t.point->model.c_str(), t.point->mason, static_cast<unsigned long long>(t.point->seed), dir.c_str());
     const auto p0 = std::chrono::steady_clock::now();
     try {
-      const RunSummary s = run_scene(t.scene, {dir, true});
+      RunOptions ro;
+      ro.out_dir = dir;
+      ro.quiet = true;
+      ro.resume = true;  // a point killed mid-run continues from its last checkpoint
+      const RunSummary s = run_scene(t.scene, ro);
       ++outcome.ran;
       if (!opt.quiet)
         std::fprintf(stderr, "           stress_total = %.5g +- %.2g Pa, drift z = %.2f\n", s.stress_total.mean,

@@ -5,6 +5,7 @@
 //  overdamped  v = u(x) + F/gamma, x += v dt   (inertialess, first order)
 #pragma once
 #include "mrf/integrate/stability.hpp"
+#include "mrf/io/archive.hpp"
 #include "mrf/scene/dem_forces.hpp"
 #include "mrf/scene/shear_cell.hpp"
 
@@ -26,6 +27,12 @@ class DemModel {
   long steps() const { return steps_; }
   // Largest overlap the chosen dt keeps stable (m); exceeding it stops the run.
   double overlap_limit() const { return overlap_limit_; }
+
+  // Checkpoint: the whole dynamic state (particles, walls, forces, pair
+  // lists, clock), so that a restored model continues bit for bit
+  // (scene/dem_checkpoint.cpp). load() expects a model built from the same scene.
+  void save(ArchiveWriter& out) const;
+  void load(ArchiveReader& in);
 
  private:
   void update_forces();

@@ -3,6 +3,7 @@
 // summary.json, and return the summary.
 #pragma once
 #include <map>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,20 @@ TimeStepChoice choose_time_step(const LoadedScene& scene, const DemParams& p);
 struct RunOptions {
   std::string out_dir;  // empty: write nothing
   bool quiet = false;   // no progress or start-up table on stderr
+  // Checkpoints (DEM runs): out_dir/checkpoint.bin, written atomically at a
+  // time-series row boundary every `checkpoint_seconds` of wall time (or every
+  // `checkpoint_every_rows` rows when > 0), removed when the run completes.
+  // With `resume` a run continues from it and ends bit for bit as an
+  // uninterrupted run would (the wall time aside).
+  bool resume = false;
+  double checkpoint_seconds = 60;
+  long checkpoint_every_rows = 0;
+  long stop_after_steps = 0;  // tests: throw RunInterrupted after this step, as a kill would stop the run
+};
+
+// Thrown by run_scene when RunOptions::stop_after_steps is reached.
+struct RunInterrupted : std::runtime_error {
+  explicit RunInterrupted(long step) : std::runtime_error("run stopped at step " + std::to_string(step)) {}
 };
 
 struct Measurement {
