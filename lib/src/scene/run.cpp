@@ -239,6 +239,7 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
   for (std::size_t i = 0; i < cell.free.size(); ++i) cell.free.v[i] = couette_velocity(cell.free.x[i], c.shear_rate);
 
   RunSummary s = dem_summary_header(c, p, ts, cell);
+  s.extra.insert({{"dipole_cutoff", c.dipole_cutoff}, {"gap", c.gap}, {"box_ly", c.ly}, {"box_lz", c.lz}});
   if (!opt.quiet) print_limits(ts, s);
 
   DemModel model(std::move(cell), p, ts.scheme, ts.dt);

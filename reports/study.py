@@ -1,0 +1,242 @@
+#!/usr/bin/python3
+"""The study report (issue 6): stress and relative viscosity against Mason
+number for the three models with theory and experiment, the deviation of
+models 1 and 2 from model 3 with the criterion, and the cost per strain unit.
+
+usage: study.py SWEEP_DIR OUT_DIR [--title TEXT] [--heldout DIR]...
+
+SWEEP_DIR holds sweep.csv (mrf sweep) and criterion.json (mrf criterion).
+Writes OUT_DIR/study.md, PNG+SVG figures and CSV tables. Every figure states
+the Mason-number convention and the scene parameters.
+"""
+import csv
+import json
+import math
+import os
+import sys
+from collections import defaultdict
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+MU0 = 4e-7 * math.pi
+MN_CONVENTION = "Mn = 9 eta gdot / (2 mu0 M^2)"
+LABEL = {"dem_stokes": "1: DEM-Stokes (one-way)", "demsph_stokes": "2: DEM-SPH Stokes", "demsph_dd": "3: DEM-SPH Di Felice"}
+COLOR = {"dem_stokes": "tab:blue", "demsph_stokes": "tab:orange", "demsph_dd": "tab:green"}
+ORDER = ["dem_stokes", "demsph_stokes", "demsph_dd"]
+CHAIN_YIELD = 0.13738  # tau_y / (phi mu0 M^2), point-dipole chains, REFERENCE TEST 1.5
+GINDER_SAT = 0.086     # tau_sat / (phi mu0 Ms^2), Ginder, Davis & Elie 1996
+KRIEGER = 2.75         # Krieger-Dougherty eta/eta_carrier at phi 0.3, phi_m 0.64 (REFERENCE section 8)
+
+
+def read_rows(path):
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+
+def num(row, key):
+    try:
+        return float(row[key])
+    except (KeyError, ValueError):
+        return float("nan")
+
+
+def save(fig, out, name):
+    for ext in ("png", "svg"):
+        fig.savefig(os.path.join(out, f"{name}.{ext}"), dpi=110, bbox_inches="tight")
+    plt.close(fig)
+
+
+def params_line(rows):
+    r = next(r for r in rows if r["status"] == "ok")
+    eta = num(r, "stress_fluid") / num(r, "shear_rate") if r["model"] == "dem_stokes" else float("nan")
+    return (f"{MN_CONVENTION}; phi = {num(r, 'volume_fraction'):.2f}, M = {num(r, 'magnetization'):.3g} A/m, "
+            f"Y = {num(r, 'youngs_modulus'):.3g} Pa, eta = {eta:.3g} Pa s, {int(num(r, 'n_particles'))} particles")
+
+
+def experiment_points(path):
+    """Yield stresses near phi 0.3 as tau_y/(phi mu0 M^2), from experiments/data."""
+    pts = []
+    if not os.path.exists(path):
+        return pts
+    with open(path) as f:
+        rows = list(csv.DictReader(line for line in f if not line.startswith("#")))
+    for r in rows:
+        v = num(r, "tau_over_phi_mu0_M2")
+        if math.isfinite(v) and abs(num(r, "volume_fraction") - 0.3) < 0.05 and r["source_id"] != "DANG2000":
+            pts.append((r["source_id"], num(r, "field_H_A_per_m"), v))
+    return pts
+
+
+def main(argv):
+    if len(argv) < 3:
+        print(__doc__)
+        return 2
+    sweep_dir, out = argv[1], argv[2]
+    heldout = [argv[i + 1] for i, a in enumerate(argv) if a == "--heldout"]
+    title = argv[argv.index("--title") + 1] if "--title" in argv else os.path.basename(os.path.normpath(sweep_dir))
+    os.makedirs(out, exist_ok=True)
+    rows = [r for r in read_rows(os.path.join(sweep_dir, "sweep.csv"))]
+    ok = [r for r in rows if r["status"] == "ok"]
+    crit = json.load(open(os.path.join(sweep_dir, "criterion.json")))
+    phi, m = crit["volume_fraction"], crit["magnetization"]
+    scale = phi * MU0 * m * m
+    plabel = params_line(rows)
+    models = [k for k in ORDER if k in crit["models"]]
+    here = os.path.dirname(os.path.abspath(__file__))
+    expt = experiment_points(os.path.join(here, "..", "experiments", "data", "experiment_mrf.csv"))
+
+    # ---- stress against Mn --------------------------------------------------
+    fig, ax = plt.subplots(figsize=(7.5, 5))
+    mns_all = []
+    for k in models:
+        p = crit["models"][k]["points"]
+        x = [q["mason"] for q in p]
+        mns_all += x
+        ax.errorbar(x, [q["stress"] / scale for q in p], yerr=[q["err"] / scale for q in p], fmt="o-", ms=4,
+                    capsize=3, color=COLOR[k], label=LABEL[k])
+    lo, hi = min(mns_all) / 2, max(mns_all) * 2
+    grid = [lo * (hi / lo) ** (i / 100) for i in range(101)]
+    ax.plot(grid, [CHAIN_YIELD + KRIEGER * (2 / 9) * g / phi for g in grid], "k--", lw=1,
+            label="chain model yield 0.137 + Krieger-Dougherty viscosity")
+    ax.axhline(GINDER_SAT, color="gray", ls=":", lw=1, label="Ginder saturation 0.086 (Ms = M)")
+    sources = sorted({e[0] for e in expt})
+    for src in sources:
+        vals = [v for s_, _, v in expt if s_ == src]
+        mk = "s^vD<>"[sources.index(src) % 6]
+        ax.plot([lo * 1.2] * len(vals), vals, marker=mk, color="tab:red", ms=5, ls="none",
+                label=f"experiment {src}: yield stress at {len(vals)} fields")
+    ax.set(xscale="log", yscale="log", xlabel=f"Mason number ({MN_CONVENTION})",
+           ylabel="shear stress / (phi mu0 M^2)", title=f"{title}: shear stress")
+    ax.legend(fontsize=7)
+    ax.text(0.01, -0.16, plabel + "; experiment: yield stress (no shear rate), drawn at the left edge",
+            transform=ax.transAxes, fontsize=6)
+    save(fig, out, "stress_vs_mason")
+
+    # ---- relative viscosity with fits ----------------------------------------
+    fig, ax = plt.subplots(figsize=(7.5, 5))
+    for k in models:
+        p = crit["models"][k]["points"]
+        ax.errorbar([q["mason"] for q in p], [q["eta_r"] for q in p], yerr=[q["eta_r_err"] for q in p], fmt="o",
+                    ms=4, capsize=3, color=COLOR[k], label=LABEL[k])
+        f = crit["models"][k]["power_law"]
+        if f["ok"]:
+            ax.plot(grid, [f["eta_inf"] * (1 + (f["mason_star"] / g) ** f["exponent"]) for g in grid], "-",
+                    color=COLOR[k], lw=1,
+                    label=f"fit: Mn* = {f['mason_star']:.2g} +- {f['mason_star_err']:.1g}, "
+                          f"Delta = {f['exponent']:.2f} +- {f['exponent_err']:.2f}")
+    ax.set(xscale="log", yscale="log", xlabel=f"Mason number ({MN_CONVENTION})",
+           ylabel="eta_r = tau / (eta gdot)", title=f"{title}: relative viscosity, eta_r = eta_inf (1 + (Mn*/Mn)^Delta)")
+    ax.legend(fontsize=7)
+    ax.text(0.01, -0.16, plabel, transform=ax.transAxes, fontsize=6)
+    save(fig, out, "relative_viscosity")
+
+    # ---- deviation from model 3 ----------------------------------------------
+    dev = crit.get("deviation_from_demsph_dd", {})
+    if dev:
+        fig, axs = plt.subplots(1, 2, figsize=(11, 4.5))
+        for k, d in dev.items():
+            p = d["points"]
+            for ax, xkey in zip(axs, ("mason", "share")):
+                ax.errorbar([q[xkey] for q in p], [100 * q["deviation"] for q in p],
+                            yerr=[100 * q["err"] for q in p], fmt="o-", ms=4, capsize=3, color=COLOR[k], label=LABEL[k])
+            for lvl, key in ((10, "crossing_10"), (20, "crossing_20")):
+                c = d[key]
+                if c["found"] and k == "dem_stokes":
+                    axs[0].axvline(c["mason"], color="k", ls="--" if lvl == 10 else ":", lw=1,
+                                   label=f"model 1 off by {lvl} %: Mn = {c['mason']:.2g}")
+                    axs[1].axvline(c["share"], color="k", ls="--" if lvl == 10 else ":", lw=1,
+                                   label=f"criterion s_{lvl} = {c['share']:.2f}")
+        for ax in axs:
+            for lvl in (10, 20):
+                ax.axhspan(-lvl, lvl, color="gray", alpha=0.08)
+            ax.axhline(0, color="k", lw=0.5)
+            ax.legend(fontsize=7)
+        axs[0].set(xscale="log", xlabel=f"Mason number ({MN_CONVENTION})", ylabel="tau_model / tau_3 - 1 (%)",
+                   title="deviation from model 3 (DEM-SPH Di Felice)")
+        axs[1].set(xlabel="hydrodynamic share of the model's stress, s = tau_fluid / tau_total",
+                   ylabel="tau_model / tau_3 - 1 (%)", title="the same against the hydrodynamic share")
+        axs[0].text(0.01, -0.2, plabel, transform=axs[0].transAxes, fontsize=6)
+        save(fig, out, "deviation")
+
+    # ---- cost per strain unit ------------------------------------------------
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    cost = defaultdict(list)
+    for r in ok:
+        cost[r["model"]].append((num(r, "mason"), num(r, "wall_seconds") / num(r, "strain")))
+    for k in models:
+        pts = sorted(cost[k])
+        ax.plot([p[0] for p in pts], [p[1] for p in pts], "o", color=COLOR[k], label=LABEL[k])
+    ax.set(xscale="log", yscale="log", xlabel=f"Mason number ({MN_CONVENTION})", ylabel="wall seconds per strain unit",
+           title=f"{title}: cost (one core per run)")
+    ax.legend(fontsize=7)
+    ax.text(0.01, -0.18, plabel, transform=ax.transAxes, fontsize=6)
+    save(fig, out, "cost")
+
+    # ---- tables and the report -----------------------------------------------
+    with open(os.path.join(out, "flow_curves.csv"), "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["model", "mason", "stress_Pa", "err_Pa", "seed_scatter_Pa", "within_err_Pa", "seeds",
+                    "stress_fluid_Pa", "eta_r", "eta_r_err"])
+        for k in models:
+            for q in crit["models"][k]["points"]:
+                w.writerow([k, q["mason"], q["stress"], q["err"], q["seed_scatter"], q["within_err"], q["seeds"],
+                            q["stress_fluid"], q["eta_r"], q["eta_r_err"]])
+    md = [f"# Study: shear stress against Mason number — {title}", "",
+          f"Mason number {MN_CONVENTION}. {plabel}.", "",
+          "Generated by `reports/study.py` from `sweep.csv` and `criterion.json` of `mrf sweep` / `mrf criterion`.", "",
+          "![stress](stress_vs_mason.png)", "", "![relative viscosity](relative_viscosity.png)", ""]
+    if dev:
+        md += ["![deviation](deviation.png)", ""]
+    md += ["![cost](cost.png)", "", "## Flow-curve fits (GSL, errors from the covariance, inflated by chi2/dof > 1)", "",
+           "| model | Bingham eta_inf | Bingham Mn* | chi2/dof | power-law eta_inf | Mn* | Delta | chi2/dof |",
+           "|---|---|---|---|---|---|---|---|"]
+    for k in models:
+        b, p = crit["models"][k]["bingham"], crit["models"][k]["power_law"]
+        fb = (lambda v, e: f"{v:.3g} ± {e:.2g}")
+        md.append(f"| {k} | {fb(b['eta_inf'], b['eta_inf_err'])} | {fb(b['mason_star'], b['mason_star_err'])} | "
+                  f"{b['chi2_dof']:.2g} | {fb(p['eta_inf'], p['eta_inf_err'])} | {fb(p['mason_star'], p['mason_star_err'])} | "
+                  f"{fb(p['exponent'], p['exponent_err'])} | {p['chi2_dof']:.2g} |"
+                  + ("" if p["ok"] else f" ({p['message']})"))
+    md += ["", "## Seed-averaged points", "",
+           "| model | Mn | tau (Pa) | error (Pa) | seed scatter (Pa) | within-run (Pa) | seeds | hydrodynamic share |",
+           "|---|---|---|---|---|---|---|---|"]
+    for k in models:
+        for q in crit["models"][k]["points"]:
+            md.append(f"| {k} | {q['mason']:.3g} | {q['stress']:.4g} | {q['err']:.2g} | {q['seed_scatter']:.2g} | "
+                      f"{q['within_err']:.2g} | {q['seeds']} | {q['stress_fluid'] / q['stress']:.3f} |")
+    drift = [r for r in ok if abs(num(r, "stress_total_drift_z")) > 3]
+    md += ["", f"Drift check: {len(drift)} of {len(ok)} runs have |z| > 3 between the halves of the averaging window"
+           + (": " + ", ".join(r["dir"] for r in drift) if drift else "."), ""]
+    if dev:
+        md += ["## Deviation from model 3 and the criterion", ""]
+        for k, d in dev.items():
+            for lvl, key in ((10, "crossing_10"), (20, "crossing_20")):
+                c = d[key]
+                md.append(f"- {k}: " + (f"off by {lvl} % from Mn = {c['mason']:.3g} (share s = {c['share']:.3f})"
+                                        if c["found"] else f"within {lvl} % over the whole sweep"))
+        if "derived_thresholds" in crit:
+            t = crit["derived_thresholds"]
+            md += ["", f"**Criterion.** Model 1 is within 10 % of model 3 where its hydrodynamic share "
+                       f"s = tau_fluid/tau_total < {t['share_10']:.3f} (20 %: s < {t['share_20']:.3f}); for this scene "
+                       f"that is Mn < {t['mason_10']:.3g} (20 %: Mn < {t['mason_20']:.3g}). "
+                       f"`mrf criterion RUN_DIR --thresholds FILE` prints the verdict for one DEM-Stokes run."]
+    for h in heldout:
+        hc = json.load(open(os.path.join(h, "criterion.json")))
+        v = hc.get("verdicts", {})
+        md += ["", f"### Held-out conditions: `{os.path.basename(os.path.normpath(h))}`", "",
+               f"phi = {hc['volume_fraction']:.2f}; hit rate {v.get('hit_rate', float('nan')):.2f}", "",
+               "| Mn | share s | deviation | adequate (10 %) | hit | adequate (20 %) | hit |", "|---|---|---|---|---|---|---|"]
+        for q in v.get("points", []):
+            md.append(f"| {q['mason']:.3g} | {q['share']:.3f} | {q.get('deviation', float('nan')):+.3f} | "
+                      f"{q['adequate_10']} | {q.get('hit_10', '')} | {q['adequate_20']} | {q.get('hit_20', '')} |")
+    with open(os.path.join(out, "study.md"), "w") as f:
+        f.write("\n".join(md) + "\n")
+    print(f"wrote {out}/study.md and figures")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
