@@ -295,12 +295,12 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
     model.step();
     row.add(model.sums(), model.cell().box);
     st.pair_evals += model.sums().pair_evaluations;
-    if (frame_every > 0 && n % frame_every == 0 && frames_out) write_frame(frames_out, model.cell(), p.radius, model.time());
+    if (frame_every > 0 && n % frame_every == 0 && frames_out.is_open()) write_frame(frames_out, model.cell(), p.radius, model.time());
     if (n % every != 0 && n != s.steps) continue;
     const double k = 1.0 / row.n, strain = model.time() * c.shear_rate;
     const double tp = row.tau_p * k, vm = row.vir_mag * k, vc = row.vir_con * k;
     st.max_overlap = std::max(st.max_overlap, row.max_overlap);
-    if (ts_out)
+    if (ts_out.is_open())
       ts_out << model.time() << "," << strain << "," << tp + s.stress_fluid << "," << tp << ","
              << s.stress_fluid << "," << vm << "," << vc << "," << row.max_overlap / p.radius << ","
              << row.e_dip * k << "," << row.e_hertz * k << "\n";
@@ -325,7 +325,7 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
       snap.elapsed_before += std::chrono::duration<double>(now - t0).count();
       ts_out.flush();
       snap.ts_bytes = static_cast<std::uint64_t>(std::filesystem::file_size(opt.out_dir + "/timeseries.csv"));
-      if (frames_out) {
+      if (frames_out.is_open()) {
         frames_out.flush();
         snap.frames_bytes = static_cast<std::uint64_t>(std::filesystem::file_size(opt.out_dir + "/frames.xyz"));
       }
