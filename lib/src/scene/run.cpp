@@ -22,19 +22,14 @@ TimeStepChoice choose_time_step(const LoadedScene& scene, const DemParams& p) {
   const SceneConfig& c = scene.config;
   auto ve = dem_limits(p, c, IntegratorId::verlet_exp);
   auto od = dem_limits(p, c, IntegratorId::overdamped);
+  auto im = dem_limits(p, c, IntegratorId::implicit);
   TimeStepChoice t{};
-  switch (c.integrator) {
-    case IntegratorId::verlet_exp: t.scheme = IntegratorId::verlet_exp; break;
-    case IntegratorId::overdamped: t.scheme = IntegratorId::overdamped; break;
-    case IntegratorId::automatic:
-      t.scheme = smallest(ve) >= smallest(od) ? IntegratorId::verlet_exp : IntegratorId::overdamped;
-      break;
-    case IntegratorId::implicit:
-      throw InputError("numerics.integrator", "implicit", scene.locate("numerics.integrator"),
-                       "the implicit integrator is not implemented yet (issue #7)");
+  t.scheme = c.integrator == IntegratorId::automatic ? auto_integrator(ve, od, im) : c.integrator;
+  switch (t.scheme) {
+    case IntegratorId::verlet_exp: t.limits = ve, t.other = od; break;
+    case IntegratorId::overdamped: t.limits = od, t.other = ve; break;
+    default: t.limits = im, t.other = smallest(ve) >= smallest(od) ? ve : od; break;
   }
-  t.limits = t.scheme == IntegratorId::verlet_exp ? ve : od;
-  t.other = t.scheme == IntegratorId::verlet_exp ? od : ve;
   const StabilityLimit& b = binding(t.limits);
   if (c.dt) {
     if (*c.dt > b.dt) {
@@ -47,40 +42,47 @@ TimeStepChoice choose_time_step(const LoadedScene& scene, const DemParams& p) {
     }
     t.dt = *c.dt;
   } else {
-    t.dt = c.dt_safety * b.dt;
+    // implicit: the bound is the largest step of an error-controlled scheme, not a stability limit
+    t.dt = t.scheme == IntegratorId::implicit ? b.dt : c.dt_safety * b.dt;
   }
   return t;
 }
 
 namespace {
 
-void print_limits(const TimeStepChoice& t, const RunSummary& s) {
+// The limits of every DEM integrator, the one that binds each, and the choice.
+void print_limits(const TimeStepChoice& t, const RunSummary& s, const DemParams& p, const SceneConfig& c) {
   std::fprintf(stderr, "mrf: %s, Mn = %.4g (9 eta gdot / 2 mu0 M^2), gdot = %.4g 1/s\n",
                s.model.c_str(), s.mason, s.shear_rate);
-  auto table = [](const char* scheme, const std::vector<StabilityLimit>& l) {
+  for (IntegratorId id : {IntegratorId::verlet_exp, IntegratorId::overdamped, IntegratorId::implicit}) {
+    const auto l = dem_limits(p, c, id);
     for (const auto& x : l)
-      std::fprintf(stderr, "  %-11s %-20s dt < %-10.3g  %s\n", scheme, x.name.c_str(), x.dt, x.basis.c_str());
-  };
-  table(to_string(t.scheme), t.limits);
-  table(to_string(t.scheme == IntegratorId::verlet_exp ? IntegratorId::overdamped : IntegratorId::verlet_exp),
-        t.other);
-  std::fprintf(stderr, "  chosen: %s, dt = %.4g s (bound by '%s'), %ld steps; St = %.3g, Re_p = %.3g\n",
-               to_string(t.scheme), t.dt, binding(t.limits).name.c_str(), s.steps, s.stokes_number,
-               s.reynolds_number);
+      std::fprintf(stderr, "  %-11s %-20s dt < %-10.3g  %s\n", to_string(id), x.name.c_str(), x.dt, x.basis.c_str());
+    std::fprintf(stderr, "  %-11s bound by '%s' (dt < %.3g s)\n", to_string(id), binding(l).name.c_str(), smallest(l));
+  }
+  if (t.scheme == IntegratorId::implicit)
+    std::fprintf(stderr, "  chosen: implicit, error-controlled dt <= %.4g s (bound by '%s'); St = %.3g, Re_p = %.3g\n",
+                 t.dt, binding(t.limits).name.c_str(), s.stokes_number, s.reynolds_number);
+  else
+    std::fprintf(stderr, "  chosen: %s, dt = %.4g s (bound by '%s'), %ld steps; St = %.3g, Re_p = %.3g\n",
+                 to_string(t.scheme), t.dt, binding(t.limits).name.c_str(), s.steps, s.stokes_number,
+                 s.reynolds_number);
 }
 
 // Running sums of one time-series row.
+// Running sums of one time-series row, each step weighted by w (1 for the
+// fixed-step schemes, the step length for the adaptive implicit one).
 struct Row {
   double tau_p = 0, vir_mag = 0, vir_con = 0, max_overlap = 0, e_dip = 0, e_hertz = 0;
-  int n = 0;
-  void add(const PairSums& p, const Box& box) {
-    tau_p += wall_shear_stress(p.wall_fz, box);
-    vir_mag += virial_shear_stress(p.virial_mag_xz, box);
-    vir_con += virial_shear_stress(p.virial_con_xz, box);
+  double n = 0;
+  void add(const PairSums& p, const Box& box, double w) {
+    tau_p += w * wall_shear_stress(p.wall_fz, box);
+    vir_mag += w * virial_shear_stress(p.virial_mag_xz, box);
+    vir_con += w * virial_shear_stress(p.virial_con_xz, box);
     max_overlap = std::max(max_overlap, p.max_overlap);
-    e_dip += p.energy_dipole;
-    e_hertz += p.energy_hertz;
-    ++n;
+    e_dip += w * p.energy_dipole;
+    e_hertz += w * p.energy_hertz;
+    n += w;
   }
 };
 
@@ -193,9 +195,14 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
   for (std::size_t i = 0; i < cell.free.size(); ++i) cell.free.v[i] = couette_velocity(cell.free.x[i], c.shear_rate);
 
   RunSummary s = dem_summary_header(c, p, ts, cell);
-  if (!opt.quiet) print_limits(ts, s);
+  if (!opt.quiet) print_limits(ts, s, p, c);
 
   DemModel model(std::move(cell), p, ts.scheme, ts.dt);
+  // The implicit scheme chooses its steps: it runs to the end time and writes
+  // a row every `every` steps of its largest dt, i.e. by strain interval.
+  const bool adaptive = ts.scheme == IntegratorId::implicit;
+  const double t_end = c.strain / c.shear_rate;
+  if (adaptive) model.set_stop_time(t_end);
   const long every = c.every > 0 ? c.every : std::max(1L, s.steps / 2000);
   const double rows_after_warmup = (1.0 - c.warmup_strain / c.strain) * static_cast<double>(s.steps / every);
   if (rows_after_warmup < 32)
@@ -219,12 +226,18 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
   long pair_evals = 0;
   const auto t0 = std::chrono::steady_clock::now();
   auto last_report = t0;
-  for (long n = 1; n <= s.steps; ++n) {
+  const double row_time = static_cast<double>(every) * ts.dt;
+  double row_start = 0;  // s
+  long n = 0;
+  auto running = [&] { return adaptive ? model.time() < t_end * (1 - 1e-12) : n < s.steps; };
+  while (running()) {
+    ++n;
     model.step();
-    row.add(model.sums(), model.cell().box);
+    row.add(model.sums(), model.cell().box, adaptive ? model.dt() : 1.0);
     pair_evals += model.sums().pair_evaluations;
     if (frame_every > 0 && n % frame_every == 0 && frames_out) write_frame(frames_out, model.cell(), p.radius, model.time());
-    if (n % every != 0 && n != s.steps) continue;
+    const bool due = adaptive ? model.time() >= row_start + row_time * (1 - 1e-9) : n % every == 0;
+    if (!due && running()) continue;
     const double k = 1.0 / row.n, strain = model.time() * c.shear_rate;
     const double tp = row.tau_p * k, vm = row.vir_mag * k, vc = row.vir_con * k;
     max_overlap = std::max(max_overlap, row.max_overlap);
@@ -232,7 +245,8 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
       ts_out << model.time() << "," << strain << "," << tp + s.stress_fluid << "," << tp << ","
              << s.stress_fluid << "," << vm << "," << vc << "," << row.max_overlap / p.radius << ","
              << row.e_dip * k << "," << row.e_hertz * k << "\n";
-    if (strain - row.n * ts.dt * c.shear_rate >= c.warmup_strain) {  // whole row after warm-up
+    if ((adaptive ? row_start * c.shear_rate : strain - row.n * ts.dt * c.shear_rate) >=
+        c.warmup_strain) {  // whole row after warm-up
       se.total.push_back(tp + s.stress_fluid);
       se.particles.push_back(tp);
       se.virial.push_back(vm + vc);
@@ -241,16 +255,27 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
       se.diff.push_back(tp - vm - vc);
     }
     row = Row{};
+    row_start = model.time();
     const auto now = std::chrono::steady_clock::now();
     if (!opt.quiet && std::chrono::duration<double>(now - last_report).count() > 2.0) {
       last_report = now;
       const double el = std::chrono::duration<double>(now - t0).count();
       std::fprintf(stderr, "\r  strain %.3f / %.3f  %.3g steps/s  ETA %.0f s   ", strain, c.strain,
-                   static_cast<double>(n) / el,
-                   el * static_cast<double>(s.steps - n) / static_cast<double>(n));
+                   static_cast<double>(n) / el, el * (c.strain - strain) / strain);
     }
   }
   s.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  s.steps = n;
+  if (adaptive) {
+    const ImplicitCounters& ic = model.implicit_counters();
+    s.extra["implicit_rejected_steps"] = static_cast<double>(ic.rejected);
+    s.extra["implicit_newton_failures"] = static_cast<double>(ic.newton_failures);
+    s.extra["implicit_newton_iterations"] = static_cast<double>(ic.newton_iterations);
+    s.extra["implicit_linear_iterations"] = static_cast<double>(ic.linear_iterations);
+    s.extra["implicit_dt_min"] = ic.dt_min;
+    s.extra["implicit_dt_max"] = ic.dt_max;
+    s.extra["implicit_dt_mean"] = t_end / static_cast<double>(n);
+  }
   if (!opt.quiet) std::fprintf(stderr, "\r  done: %ld steps in %.1f s%30s\n", s.steps, s.wall_seconds, "");
   s.stress_total = measure(se.total);
   s.stress_particles = measure(se.particles);
