@@ -13,6 +13,7 @@ namespace mrf {
 const char* to_string(ContactLinearSolver s) {
   switch (s) {
     case ContactLinearSolver::pcg: return "pcg";
+    case ContactLinearSolver::pcg_sgs: return "pcg_sgs";
     case ContactLinearSolver::eigen_cg: return "eigen_cg";
     case ContactLinearSolver::eigen_ldlt: return "eigen_ldlt";
   }
@@ -100,6 +101,44 @@ void ContactNewton::linearise(const std::vector<ContactPair>& pairs, const std::
     if (!b.wall) diag_inv_[b.c] += b.k;
   }
   for (auto& d : diag_inv_) d = d.inverse().eval();
+  adj_start_.assign(active_.size() + 1, 0);
+  for (const Block& b : blocks_)
+    if (!b.wall) ++adj_start_[b.a + 1], ++adj_start_[b.c + 1];
+  for (std::size_t a = 0; a < active_.size(); ++a) adj_start_[a + 1] += adj_start_[a];
+  adj_block_.resize(adj_start_.back());
+  std::vector<std::uint32_t> fill(adj_start_.begin(), adj_start_.end() - 1);
+  for (std::uint32_t n = 0; n < blocks_.size(); ++n)
+    if (!blocks_[n].wall) adj_block_[fill[blocks_[n].a]++] = n, adj_block_[fill[blocks_[n].c]++] = n;
+}
+
+// z = M^-1 r. Block Jacobi: M = D. Symmetric block Gauss-Seidel:
+// M = (D + L) D^-1 (D + U), with the off-diagonal blocks -K_pair of J.
+void ContactNewton::precondition(const std::vector<Vec3>& r, std::vector<Vec3>& z, bool sgs) const {
+  const std::size_t n = r.size();
+  z.resize(n);
+  if (!sgs) {
+    for (std::size_t a = 0; a < n; ++a) z[a] = diag_inv_[a] * r[a];
+    return;
+  }
+  auto other = [&](const Block& b, std::size_t a) { return b.a == a ? b.c : b.a; };
+  for (std::size_t a = 0; a < n; ++a) {  // forward: (D + L) y = r
+    Vec3 s = r[a];
+    for (std::uint32_t e = adj_start_[a]; e < adj_start_[a + 1]; ++e) {
+      const Block& b = blocks_[adj_block_[e]];
+      const std::uint32_t c = other(b, a);
+      if (c < a) s += b.k * z[c];
+    }
+    z[a] = diag_inv_[a] * s;
+  }
+  for (std::size_t a = n; a-- > 0;) {  // backward: (D + U) z = D y
+    Vec3 s = Vec3::Zero();
+    for (std::uint32_t e = adj_start_[a]; e < adj_start_[a + 1]; ++e) {
+      const Block& b = blocks_[adj_block_[e]];
+      const std::uint32_t c = other(b, a);
+      if (c > a) s += b.k * z[c];
+    }
+    z[a] += diag_inv_[a] * s;
+  }
 }
 
 void ContactNewton::apply(const std::vector<Vec3>& p, std::vector<Vec3>& out) const {
@@ -124,12 +163,11 @@ double dot(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
 }  // namespace
 
 // Preconditioned CG on J d = rhs over the particles in contact.
-long ContactNewton::solve_pcg(double rtol) {
+long ContactNewton::solve_pcg(double rtol, bool sgs) {
   const std::size_t n = active_.size();
   d_.assign(n, Vec3::Zero());
   r_ = rhs_;
-  z_.resize(n);
-  for (std::size_t a = 0; a < n; ++a) z_[a] = diag_inv_[a] * r_[a];
+  precondition(r_, z_, sgs);
   p_ = z_;
   double rz = dot(r_, z_);
   const double stop2 = rtol * rtol * dot(rhs_, rhs_);
@@ -141,8 +179,8 @@ long ContactNewton::solve_pcg(double rtol) {
     for (std::size_t a = 0; a < n; ++a) {
       d_[a] += alpha * p_[a];
       r_[a] -= alpha * q_[a];
-      z_[a] = diag_inv_[a] * r_[a];
     }
+    precondition(r_, z_, sgs);
     const double rz_new = dot(r_, z_);
     const double beta = rz_new / rz;
     rz = rz_new;
@@ -223,8 +261,9 @@ NewtonResult ContactNewton::solve(const std::vector<ContactPair>& pairs, const s
         const std::uint32_t i = active_[a];
         rhs_[a] = b[i] + dt_over_gamma * f_[i] - y[i];
       }
-      res.linear_iterations += opt.solver == ContactLinearSolver::pcg ? solve_pcg(opt.linear_rtol)
-                                                                      : solve_eigen(opt.solver, opt.linear_rtol);
+      const bool own = opt.solver == ContactLinearSolver::pcg || opt.solver == ContactLinearSolver::pcg_sgs;
+      res.linear_iterations += own ? solve_pcg(opt.linear_rtol, opt.solver == ContactLinearSolver::pcg_sgs)
+                                   : solve_eigen(opt.solver, opt.linear_rtol);
       for (std::size_t a = 0; a < active_.size(); ++a) {
         step_[active_[a]] = d_[a];
         slope -= rhs_[a].dot(d_[a]);

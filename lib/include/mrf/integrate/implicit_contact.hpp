@@ -24,6 +24,7 @@ namespace mrf {
 // Linear solver of the Newton correction J d = -G.
 enum class ContactLinearSolver {
   pcg,          // matrix-free conjugate gradients on the contact pairs, 3x3 block-Jacobi preconditioner
+  pcg_sgs,      // the same with a symmetric block Gauss-Seidel preconditioner (sweeps along the pairs)
   eigen_cg,     // Eigen::ConjugateGradient on the assembled sparse J (diagonal preconditioner)
   eigen_ldlt,   // Eigen::SimplicialLDLT on the assembled sparse J (direct)
 };
@@ -87,7 +88,8 @@ class ContactNewton {
   };
   void linearise(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& y, const WallParticles& walls,
                  const Box& box, double radius, double hertz_k, double dt_over_gamma);
-  long solve_pcg(double rtol);
+  long solve_pcg(double rtol, bool sgs);
+  void precondition(const std::vector<Vec3>& r, std::vector<Vec3>& z, bool sgs) const;
   long solve_eigen(ContactLinearSolver s, double rtol);
   void apply(const std::vector<Vec3>& p, std::vector<Vec3>& out) const;  // J p on the active set
 
@@ -95,7 +97,8 @@ class ContactNewton {
   std::vector<std::int32_t> local_;        // particle -> compact index, -1 when not in contact
   std::vector<std::uint32_t> active_;      // compact -> particle
   std::vector<Block> blocks_;
-  std::vector<Eigen::Matrix3d> diag_inv_;  // block-Jacobi preconditioner
+  std::vector<Eigen::Matrix3d> diag_inv_;  // inverse diagonal blocks of J
+  std::vector<std::uint32_t> adj_start_, adj_block_;  // free-free blocks of each active particle (CSR)
   std::vector<Vec3> rhs_, d_, r_, z_, p_, q_;  // linear solve on the active set
   std::vector<Vec3> step_, trial_;             // Newton direction, line-search trial point
 };
