@@ -53,70 +53,92 @@ def run(build, label, sets):
     return j
 
 
+def mean_over_seeds(runs):
+    """Seed mean of stress_total; its error from the seed scatter (n - 1 dof)
+    and the mean block-averaging error, whichever is larger."""
+    x = [r["stress_total"] for r in runs]
+    n = len(x)
+    m = sum(x) / n
+    scatter = math.sqrt(sum((v - m) ** 2 for v in x) / (n - 1) / n) if n > 1 else 0.0
+    block = math.sqrt(sum(r["stress_total_err"] ** 2 for r in runs)) / n
+    return m, max(scatter, block), sum(r["wall_seconds"] / r["strain"] for r in runs) / n
+
+
 def main():
-    build = sys.argv[1] if len(sys.argv) > 1 else os.path.join(ROOT, "build")
+    build = sys.argv[1] if len(sys.argv) > 1 and not sys.argv[1].startswith("--") else os.path.join(ROOT, "build")
     quick = "--quick" in sys.argv
     strain, warm = ("3", "1") if quick else ("6", "2")
+    seeds = [1, 2] if quick else [1, 2, 3]
     drive = [f"drive.strain={strain}", f"drive.warmup_strain={warm}"]
-    rows = []
+    runs = []
     # Side by side: one strain unit at Y = 200 GPa, implicit vs the best explicit.
     one = ["drive.strain=1", "drive.warmup_strain=0.3"]
     t_exp = run(build, "timing verlet_exp 200GPa", one + ["numerics.integrator=verlet_exp"])
     t_imp = run(build, "timing implicit 200GPa", one + ["numerics.integrator=implicit"])
-    rows += [t_exp, t_imp]
-    for y in ["0.2 GPa", "2 GPa", "20 GPa", "200 GPa"]:
-        rows.append(run(build, f"explicit {y}", drive + ["numerics.integrator=verlet_exp",
-                                                          f'contact.youngs_modulus="{y}"']))
-    ref = rows[-1]
-    for y in ["2 GPa", "20 GPa"]:
-        rows.append(run(build, f"implicit {y}", drive + ["numerics.integrator=implicit",
-                                                          f'contact.youngs_modulus="{y}"']))
-    rows.append(run(build, "implicit 200 GPa", drive + ["numerics.integrator=implicit"]))
+    configs = [("verlet_exp", y) for y in ["0.2 GPa", "2 GPa", "20 GPa", "200 GPa"]] + \
+              [("implicit", y) for y in ["2 GPa", "20 GPa", "200 GPa"]]
+    groups = {}
+    for scheme, y in configs:
+        for seed in seeds:
+            r = run(build, f"{scheme} {y} seed {seed}", drive + [f"numerics.integrator={scheme}",
+                                                                  f'contact.youngs_modulus="{y}"', f"scene.seed={seed}"])
+            r["seed"] = seed
+            runs.append(r)
+            groups.setdefault((scheme, y), []).append(r)
+    ref_m, ref_e, _ = mean_over_seeds(groups[("verlet_exp", "200 GPa")])
 
+    keys = ["label", "integrator", "youngs_modulus", "seed", "strain", "warmup_strain", "stress_total",
+            "stress_total_err", "steps", "wall_seconds", "max_overlap_over_radius", "implicit_dt_mean",
+            "implicit_rejected_steps", "implicit_newton_failures", "implicit_newton_iterations",
+            "implicit_linear_iterations"]
+    with open(os.path.join(HERE, "implicit_small_scene_runs.csv"), "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(keys)
+        for r in [t_exp, t_imp] + runs:
+            w.writerow([r.get(k, "") for k in keys])
     path_csv = os.path.join(HERE, "implicit_small_scene.csv")
-    keys = ["label", "integrator", "youngs_modulus", "strain", "warmup_strain", "stress_total", "stress_total_err",
-            "steps", "wall_seconds", "max_overlap_over_radius", "implicit_dt_mean", "implicit_rejected_steps",
-            "implicit_newton_iterations", "implicit_linear_iterations", "implicit_newton_failures"]
+    points = []
     with open(path_csv, "w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(keys + ["seconds_per_strain", "error_vs_reference_Pa", "error_bar_Pa"])
-        for r in rows:
-            err = abs(r["stress_total"] - ref["stress_total"])
-            bar = math.hypot(r["stress_total_err"], ref["stress_total_err"]) if r is not ref else r["stress_total_err"]
-            w.writerow([r.get(k, "") for k in keys] +
-                       [r["wall_seconds"] / r["strain"], err if r is not ref else 0.0, bar])
-    print(f"timing, one strain unit at 200 GPa: verlet_exp {t_exp['wall_seconds']:.2f} s, implicit "
+        w.writerow(["integrator", "youngs_modulus_Pa", "seeds", "stress_total_mean_Pa", "stress_total_err_Pa",
+                    "seconds_per_strain", "error_vs_reference_Pa", "error_bar_Pa", "max_overlap_over_radius"])
+        for (scheme, y), g in groups.items():
+            m, e, sec = mean_over_seeds(g)
+            is_ref = (scheme, y) == ("verlet_exp", "200 GPa")
+            err = 0.0 if is_ref else abs(m - ref_m)
+            bar = e if is_ref else math.hypot(e, ref_e)
+            ov = max(r["max_overlap_over_radius"] for r in g)
+            w.writerow([scheme, g[0]["youngs_modulus"], len(g), m, e, sec, err, bar, ov])
+            points.append((scheme, g[0]["youngs_modulus"], m, e, sec, err, bar, is_ref))
+            print(f"{scheme:10s} {y:8s}: {m:.1f} +- {e:.1f} Pa, {sec:.2f} s per strain, |error| {err:.1f} +- {bar:.1f}"
+                  f" Pa, max overlap/R {ov:.3g}")
+    print(f"timing, one strain unit at 200 GPa, side by side: verlet_exp {t_exp['wall_seconds']:.2f} s, implicit "
           f"{t_imp['wall_seconds']:.2f} s, ratio {t_exp['wall_seconds'] / t_imp['wall_seconds']:.2f}")
 
-    fig, ax = plt.subplots(figsize=(5.2, 3.8), dpi=110)
-    styles = {"explicit": ("o", "tab:blue"), "implicit": ("s", "tab:red")}
-    for r in rows[2:]:
-        kind = "implicit" if r["integrator"] == "implicit" else "explicit"
-        stiff = r["youngs_modulus"] >= 1e11
-        m, c = styles[kind]
-        err = abs(r["stress_total"] - ref["stress_total"])
-        bar = math.hypot(r["stress_total_err"], ref["stress_total_err"])
-        x = r["wall_seconds"] / r["strain"]
-        if r is ref:
-            ax.axvline(x, color=c, ls="--", lw=1)
-            ax.annotate("reference (explicit 200 GPa)", (x, 3.0), fontsize=7, rotation=90, ha="right")
+    fig, ax = plt.subplots(figsize=(5.4, 4.0), dpi=110)
+    styles = {"verlet_exp": ("o", "tab:blue"), "implicit": ("s", "tab:red")}
+    floor = 3.0
+    for scheme, y, m, e, sec, err, bar, is_ref in points:
+        mk, c = styles[scheme]
+        if is_ref:
+            ax.axvline(sec, color=c, ls="--", lw=1)
+            ax.annotate("reference: explicit 200 GPa", (sec, floor * 1.2), fontsize=7, rotation=90, ha="right")
             continue
-        ax.errorbar(x, max(err, 3.0), yerr=[[min(bar, max(err, 3.0) - 1.0)], [bar]], fmt=m, color=c,
-                    mfc=c if stiff else "white", capsize=2)
-        ax.annotate(f"{r['youngs_modulus'] / 1e9:g} GPa", (x, max(err, 3.0)), textcoords="offset points",
-                    xytext=(4, 4), fontsize=7)
+        yv = max(err, floor)
+        ax.errorbar(sec, yv, yerr=[[min(bar, yv - 1.0)], [bar]], fmt=mk, color=c,
+                    mfc=c if y >= 1e11 else "white", capsize=2)
+        ax.annotate(f"{y / 1e9:g} GPa", (sec, yv), textcoords="offset points", xytext=(4, 4), fontsize=7)
     ax.errorbar([], [], fmt="o", color="tab:blue", mfc="white", label="explicit verlet_exp, soft Y")
-    ax.errorbar([], [], fmt="o", color="tab:blue", label="explicit verlet_exp, Y = 200 GPa")
     ax.errorbar([], [], fmt="s", color="tab:red", mfc="white", label="implicit, soft Y")
     ax.errorbar([], [], fmt="s", color="tab:red", label="implicit, Y = 200 GPa")
-    ax.axhline(ref["stress_total_err"], color="gray", ls=":", lw=1, label="reference error bar")
+    ax.axhline(ref_e, color="gray", ls=":", lw=1, label="reference error bar")
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("wall time per strain unit (s, 1 thread)")
     ax.set_ylabel("|stress_total - reference| (Pa)")
-    ax.set_title(f"small scene, Mn = 1e-2; reference {ref['stress_total']:.0f} ± {ref['stress_total_err']:.0f} Pa",
-                 fontsize=9)
-    ax.legend(fontsize=7)
+    ax.set_title(f"small scene, Mn = 1e-2, {len(seeds)} seeds, strain {warm}-{strain}; "
+                 f"reference {ref_m:.0f} ± {ref_e:.0f} Pa", fontsize=8)
+    ax.legend(fontsize=7, loc="upper right")
     fig.tight_layout()
     fig.savefig(os.path.join(HERE, "implicit_small_scene.png"))
     print("wrote", path_csv)

@@ -75,7 +75,7 @@ void DemModel::implicit_step() {
   std::vector<Vec3>& w = w_;  // explicit drift u(x_n) + F_nc(x_n)/gamma
   w.resize(n);
   for (std::size_t i = 0; i < n; ++i) w[i] = drift_velocity(x0_[i], f.f[i] - fc_[i], inv_gamma, p_.shear_rate);
-  const NewtonOptions nopt{opt_.newton_tol_over_radius * r, 20, opt_.linear_rtol, opt_.solver};
+  const NewtonOptions nopt{opt_.newton_tol_over_radius * r, opt_.max_newton, opt_.linear_rtol, opt_.solver};
   // Land on the stop time without leaving a sliver for the next step.
   const double remaining = stop_time_ - time_;
   double dt = opt_.fixed_step ? dt_max_ : dt_try_;

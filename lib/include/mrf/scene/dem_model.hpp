@@ -23,7 +23,8 @@ namespace mrf {
 struct ImplicitOptions {
   double tol_over_radius = 1e-2;         // largest local error per step / R
   double newton_tol_over_radius = 1e-6;  // largest Newton correction at convergence / R
-  double linear_rtol = 1e-2;             // relative residual of each linear solve (inexact Newton)
+  double linear_rtol = 1e-1;             // relative residual of each linear solve (inexact Newton)
+  int max_newton = 20;                   // iterations before the step is retried at dt/4
   bool fixed_step = false;               // every step = the dt given (convergence tests); no error control
   ContactLinearSolver solver = ContactLinearSolver::pcg;
 };
