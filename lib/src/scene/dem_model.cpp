@@ -60,21 +60,54 @@ void DemModel::step() {
     exp_verlet_correct(f.x, f.v, f.f, w_, p_.tau_p, p_.gamma, p_.shear_rate, dt_);
 }
 
+// One try of an IMEX Euler step of length dt from x0_ (explicit drift in w_):
+// Newton for y = b + (dt/gamma) F_c(y), b = x_n + dt w, walls at t_{n+1}.
+// Leaves y in free.x; returns the Newton result, the error estimate (half the
+// largest distance from the predictor x_n + dt v_n) and the largest displacement.
+DemModel::Attempt DemModel::attempt(double dt, const NewtonOptions& nopt) {
+  auto& f = cell_.free;
+  const std::size_t n = f.size();
+  const double dt_over_gamma = dt / p_.gamma;
+  b_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    b_[i] = x0_[i] + dt * w_[i];
+    f.x[i] = x0_[i] + dt * f.v[i];  // predictor
+  }
+  cell_.walls.x = walls0_;
+  move_walls(cell_.walls, p_.shear_rate, dt);
+  // Newton starts from the predictor or from x_n, whichever is lower in the
+  // merit function: after a sudden change (a contact made or broken) the
+  // extrapolated slope can throw the predictor far off.
+  const double phi_pred = newton_.merit(candidates_, b_, cell_.walls, cell_.box, p_.radius, p_.hertz_k, dt_over_gamma, f.x);
+  if (newton_.merit(candidates_, b_, cell_.walls, cell_.box, p_.radius, p_.hertz_k, dt_over_gamma, x0_) < phi_pred)
+    f.x = x0_;
+  Attempt a;
+  a.newton = newton_.solve(candidates_, b_, cell_.walls, cell_.box, p_.radius, p_.hertz_k, dt_over_gamma, nopt, f.x);
+  counters_.newton_iterations += a.newton.iterations;
+  counters_.linear_iterations += a.newton.linear_iterations;
+  for (std::size_t i = 0; i < n; ++i) {
+    a.error = std::max(a.error, 0.5 * (f.x[i] - x0_[i] - dt * f.v[i]).norm());
+    a.displacement = std::max(a.displacement, (f.x[i] - x0_[i]).norm());
+  }
+  return a;
+}
+
 // IMEX Euler (REFERENCE §3, contacts implicit), one accepted step:
 //   y = x_n + dt (u(x_n) + F_nc(x_n)/gamma) + (dt/gamma) F_c(y),
-// error-controlled (ImplicitOptions); walls at t_{n+1} during the solve.
+// error-controlled (ImplicitOptions): a step is retried shorter when Newton
+// fails (dt/4), a particle or the walls move more than half the contact
+// margin (dt/2), or the error estimate exceeds the tolerance.
 void DemModel::implicit_step() {
   auto& f = cell_.free;
-  const double r = p_.radius, margin = k_margin_over_radius * r, inv_gamma = 1.0 / p_.gamma;
+  const double r = p_.radius, margin = k_margin_over_radius * r;
   const double wall_speed = std::abs(p_.shear_rate) * 0.5 * cell_.box.gap;
   contact_candidates(lists_, f.x, cell_.walls, cell_.box, r, margin, candidates_);
   contact_forces(candidates_, f.x, cell_.walls, cell_.box, r, p_.hertz_k, fc_);
   x0_ = f.x;
   walls0_ = cell_.walls.x;
-  const std::size_t n = f.size();
-  std::vector<Vec3>& w = w_;  // explicit drift u(x_n) + F_nc(x_n)/gamma
-  w.resize(n);
-  for (std::size_t i = 0; i < n; ++i) w[i] = drift_velocity(x0_[i], f.f[i] - fc_[i], inv_gamma, p_.shear_rate);
+  w_.resize(f.size());  // explicit drift u(x_n) + F_nc(x_n)/gamma, F_nc = F - F_c
+  for (std::size_t i = 0; i < f.size(); ++i)
+    w_[i] = drift_velocity(x0_[i], f.f[i] - fc_[i], 1.0 / p_.gamma, p_.shear_rate);
   const NewtonOptions nopt{opt_.newton_tol_over_radius * r, opt_.max_newton, opt_.linear_rtol, opt_.solver};
   // Land on the stop time without leaving a sliver for the next step.
   const double remaining = stop_time_ - time_;
@@ -83,62 +116,30 @@ void DemModel::implicit_step() {
     dt = remaining <= dt_max_ ? remaining : 0.5 * remaining;
   const double dt_floor = k_dt_floor * std::min(dt, dt_max_);
   for (;;) {
-    if (!(dt >= dt_floor)) {
-      std::ostringstream s;
-      s << "implicit step failed at step " << steps_ << " (t = " << time_ << " s): the step size fell to " << dt
-        << " s (below " << k_dt_floor << " of numerics.dt " << dt_max_ << " s) without meeting the error tolerance or "
-        << "a converged Newton solve; last Newton correction largest at particle " << newton_worst_;
-      throw NumericalError(s.str());
-    }
-    b_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      b_[i] = x0_[i] + dt * w[i];
-      f.x[i] = x0_[i] + dt * f.v[i];  // predictor
-    }
-    cell_.walls.x = walls0_;
-    move_walls(cell_.walls, p_.shear_rate, dt);
-    // Newton starts from the predictor or from x_n, whichever is lower in the
-    // merit function: after a sudden change (a contact made or broken) the
-    // extrapolated slope can throw the predictor far off.
-    const double phi_pred = newton_.merit(candidates_, b_, cell_.walls, cell_.box, r, p_.hertz_k, dt * inv_gamma, f.x);
-    if (newton_.merit(candidates_, b_, cell_.walls, cell_.box, r, p_.hertz_k, dt * inv_gamma, x0_) < phi_pred)
-      f.x = x0_;
-    const NewtonResult nr = newton_.solve(candidates_, b_, cell_.walls, cell_.box, r, p_.hertz_k,
-                                          dt * inv_gamma, nopt, f.x);
-    counters_.newton_iterations += nr.iterations;
-    counters_.linear_iterations += nr.linear_iterations;
-    newton_worst_ = nr.worst;
-    double err = 0, disp = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      err = std::max(err, (f.x[i] - x0_[i] - dt * f.v[i]).norm());
-      disp = std::max(disp, (f.x[i] - x0_[i]).norm());
-    }
-    if (opt_.fixed_step && (!nr.converged || disp > 0.5 * margin || wall_speed * dt > 0.5 * margin)) {
+    const Attempt a = attempt(dt, nopt);
+    const bool too_far = a.displacement > 0.5 * margin || wall_speed * dt > 0.5 * margin;
+    const double ratio = a.error / (opt_.tol_over_radius * r);
+    if (opt_.fixed_step && (!a.newton.converged || too_far)) {
       std::ostringstream m;
       m << "implicit fixed step " << dt << " s failed at step " << steps_ << " (t = " << time_ << " s): "
-        << (nr.converged ? "a particle moved more than the contact margin" : "Newton did not converge")
-        << "; largest correction at particle " << nr.worst;
+        << (a.newton.converged ? "a particle moved more than the contact margin" : "Newton did not converge")
+        << "; largest correction at particle " << a.newton.worst;
       throw NumericalError(m.str());
     }
-    if (!nr.converged) {
-      ++counters_.newton_failures;
-      dt *= 0.25;
-      continue;
+    if (a.newton.converged && !too_far && (ratio <= 1.0 || opt_.fixed_step)) {
+      for (std::size_t i = 0; i < f.size(); ++i) f.v[i] = (f.x[i] - x0_[i]) / dt;
+      dt_try_ = std::min(dt_max_, dt * std::min(2.0, 0.9 / std::sqrt(std::max(ratio, 1e-6))));
+      break;
     }
-    const double ratio = 0.5 * err / (opt_.tol_over_radius * r);
-    if (disp > 0.5 * margin || wall_speed * dt > 0.5 * margin) {
-      ++counters_.rejected;
-      dt *= 0.5;
-      continue;
+    ++(a.newton.converged ? counters_.rejected : counters_.newton_failures);
+    dt *= !a.newton.converged ? 0.25 : too_far ? 0.5 : std::max(0.2, 0.9 / std::sqrt(ratio));
+    if (!(dt >= dt_floor)) {
+      std::ostringstream m;
+      m << "implicit step failed at step " << steps_ << " (t = " << time_ << " s): the step size fell to " << dt
+        << " s (below " << k_dt_floor << " of numerics.dt " << dt_max_ << " s) without meeting the error tolerance"
+        << " or a converged Newton solve; last Newton correction largest at particle " << a.newton.worst;
+      throw NumericalError(m.str());
     }
-    if (ratio > 1.0 && !opt_.fixed_step) {
-      ++counters_.rejected;
-      dt *= std::max(0.2, 0.9 / std::sqrt(ratio));
-      continue;
-    }
-    for (std::size_t i = 0; i < n; ++i) f.v[i] = (f.x[i] - x0_[i]) / dt;
-    dt_try_ = std::min(dt_max_, dt * std::min(2.0, 0.9 / std::sqrt(std::max(ratio, 1e-6))));
-    break;
   }
   dt_ = dt;
   counters_.dt_min = std::min(counters_.dt_min, dt);

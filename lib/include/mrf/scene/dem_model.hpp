@@ -65,6 +65,11 @@ class DemModel {
  private:
   void update_forces();
   void implicit_step();
+  struct Attempt {
+    NewtonResult newton;
+    double error = 0, displacement = 0;  // m
+  };
+  Attempt attempt(double dt, const NewtonOptions& nopt);
   void check_finite_positions() const;  // before binning: the cell list needs finite coordinates
   void check_finite() const;
 
@@ -86,7 +91,6 @@ class DemModel {
   ContactNewton newton_;
   std::vector<ContactPair> candidates_;
   std::vector<Vec3> x0_, b_, fc_, walls0_;
-  std::uint32_t newton_worst_ = 0;
 };
 
 }  // namespace mrf
