@@ -23,6 +23,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "mrf/error.hpp"
 #include "mrf/forces/dipole.hpp"
 #include "mrf/forces/drag.hpp"
 #include "mrf/forces/hertz.hpp"
@@ -291,6 +292,22 @@ TEST(ImplicitStability, ChainFarAboveTheExplicitLimitsStaysFiniteWithBoundedOver
   const double h_chain = hertz_overlap_under_load((1 + 2 / 16.0 + 3 / 81.0) * p.contact_force, p.hertz_k);
   EXPECT_NEAR(run.max_overlap / h_chain, 1.0, 0.01) << "static chain overlap " << h_chain;
   EXPECT_LT(max_error(pb, run.x, {ref}), 1e-3 * p.radius);  // settled: both at the same equilibrium
+}
+
+// A fixed step far beyond what the explicit dipole force and the contact
+// margin allow (1e-5 s: the zigzag chain would move by several R) stops with
+// a NumericalError that names the step and a particle, before any NaN.
+TEST(ImplicitStability, OversizedFixedStepStopsWithAClearError) {
+  const Problem pb = chain_problem(2.7925e4, 22 - 0.002, 0.25);
+  try {
+    run_implicit(pb, 1e-5, {1e-5});
+    ADD_FAILURE() << "no NumericalError";
+  } catch (const NumericalError& e) {
+    const std::string msg = e.what();
+    std::printf("%s\n", msg.c_str());
+    EXPECT_NE(msg.find("at step 0"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("particle"), std::string::npos) << msg;
+  }
 }
 
 }  // namespace

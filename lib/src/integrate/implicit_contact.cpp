@@ -69,9 +69,9 @@ Eigen::Matrix3d hertz_stiffness_block(const Vec3& r_ik, double two_r, double her
   return hertz_local_stiffness(h, hertz_k) * nn - f_over_r * (Eigen::Matrix3d::Identity() - nn);
 }
 
-void ContactNewton::linearise(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& y,
-                              const WallParticles& walls, const Box& box, double radius, double hertz_k,
-                              double dt_over_gamma) {
+double ContactNewton::linearise(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& b_step,
+                                const std::vector<Vec3>& y, const WallParticles& walls, const Box& box,
+                                double radius, double hertz_k, double dt_over_gamma) {
   f_.assign(y.size(), Vec3::Zero());
   local_.assign(y.size(), -1);
   active_.clear();
@@ -84,10 +84,12 @@ void ContactNewton::linearise(const std::vector<ContactPair>& pairs, const std::
     return static_cast<std::uint32_t>(local_[i]);
   };
   const double two_r = 2.0 * radius;
+  double energy = 0;
   for (const ContactPair& c : pairs) {
     const Vec3 r_ik = separation(c, y, walls, box);
     const double r = r_ik.norm(), h = two_r - r;
     if (h <= 0) continue;
+    energy += hertz_energy(h, hertz_k);
     const Vec3 fc = (hertz_force(h, hertz_k) / r) * r_ik;
     f_[c.i] += fc;
     if (!c.wall) f_[c.k] -= fc;
@@ -100,6 +102,8 @@ void ContactNewton::linearise(const std::vector<ContactPair>& pairs, const std::
     diag_inv_[b.a] += b.k;
     if (!b.wall) diag_inv_[b.c] += b.k;
   }
+  double phi = dt_over_gamma * energy;
+  for (std::size_t i = 0; i < y.size(); ++i) phi += 0.5 * (y[i] - b_step[i]).squaredNorm();
   for (auto& d : diag_inv_) d = d.inverse().eval();
   adj_start_.assign(active_.size() + 1, 0);
   for (const Block& b : blocks_)
@@ -109,6 +113,7 @@ void ContactNewton::linearise(const std::vector<ContactPair>& pairs, const std::
   std::vector<std::uint32_t> fill(adj_start_.begin(), adj_start_.end() - 1);
   for (std::uint32_t n = 0; n < blocks_.size(); ++n)
     if (!blocks_[n].wall) adj_block_[fill[blocks_[n].a]++] = n, adj_block_[fill[blocks_[n].c]++] = n;
+  return phi;
 }
 
 // z = M^-1 r. Block Jacobi: M = D. Symmetric block Gauss-Seidel:
@@ -247,7 +252,7 @@ NewtonResult ContactNewton::solve(const std::vector<ContactPair>& pairs, const s
   const std::size_t n = y.size();
   step_.resize(n);
   for (res.iterations = 1; res.iterations <= opt.max_iterations; ++res.iterations) {
-    linearise(pairs, y, walls, box, radius, hertz_k, dt_over_gamma);
+    const double phi0 = linearise(pairs, b, y, walls, box, radius, hertz_k, dt_over_gamma);
     // Particles out of contact: J = I, the correction is -G itself.
     double slope = 0;  // G . d
     for (std::size_t i = 0; i < n; ++i) {
@@ -276,7 +281,6 @@ NewtonResult ContactNewton::solve(const std::vector<ContactPair>& pairs, const s
     if (!std::isfinite(worst)) return res;
     double alpha = 1;
     if (worst > k_line_search_above * opt.tol && slope < 0) {
-      const double phi0 = merit(pairs, b, walls, box, radius, hertz_k, dt_over_gamma, y);
       trial_ = y;
       for (; alpha > 1e-3; alpha *= 0.5) {
         for (std::size_t i = 0; i < n; ++i) trial_[i] = y[i] + alpha * step_[i];

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <string>
 
 #include "mrf/error.hpp"
 #include "mrf/forces/hertz.hpp"
@@ -87,7 +88,8 @@ DemModel::Attempt DemModel::attempt(double dt, const NewtonOptions& nopt) {
   counters_.linear_iterations += a.newton.linear_iterations;
   for (std::size_t i = 0; i < n; ++i) {
     a.error = std::max(a.error, 0.5 * (f.x[i] - x0_[i] - dt * f.v[i]).norm());
-    a.displacement = std::max(a.displacement, (f.x[i] - x0_[i]).norm());
+    const double d = (f.x[i] - x0_[i]).norm();
+    if (d > a.displacement) a.displacement = d, a.moved = static_cast<std::uint32_t>(i);
   }
   return a;
 }
@@ -122,8 +124,10 @@ void DemModel::implicit_step() {
     if (opt_.fixed_step && (!a.newton.converged || too_far)) {
       std::ostringstream m;
       m << "implicit fixed step " << dt << " s failed at step " << steps_ << " (t = " << time_ << " s): "
-        << (a.newton.converged ? "a particle moved more than the contact margin" : "Newton did not converge")
-        << "; largest correction at particle " << a.newton.worst;
+        << (a.newton.converged ? "particle " + std::to_string(a.moved) + " moved " + std::to_string(a.displacement / r) +
+                                     " R, more than half the contact margin"
+                               : "Newton did not converge; largest correction at particle " +
+                                     std::to_string(a.newton.worst));
       throw NumericalError(m.str());
     }
     if (a.newton.converged && !too_far && (ratio <= 1.0 || opt_.fixed_step)) {

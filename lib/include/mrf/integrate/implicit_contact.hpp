@@ -86,8 +86,9 @@ class ContactNewton {
     bool wall;
     Eigen::Matrix3d k;   // (dt/gamma) K_pair
   };
-  void linearise(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& y, const WallParticles& walls,
-                 const Box& box, double radius, double hertz_k, double dt_over_gamma);
+  // Forces, residual, Jacobian blocks and preconditioner at y; returns Phi(y).
+  double linearise(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& b, const std::vector<Vec3>& y,
+                   const WallParticles& walls, const Box& box, double radius, double hertz_k, double dt_over_gamma);
   long solve_pcg(double rtol, bool sgs);
   void precondition(const std::vector<Vec3>& r, std::vector<Vec3>& z, bool sgs) const;
   long solve_eigen(ContactLinearSolver s, double rtol);

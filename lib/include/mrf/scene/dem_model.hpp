@@ -68,6 +68,7 @@ class DemModel {
   struct Attempt {
     NewtonResult newton;
     double error = 0, displacement = 0;  // m
+    std::uint32_t moved = 0;             // particle with the largest displacement
   };
   Attempt attempt(double dt, const NewtonOptions& nopt);
   void check_finite_positions() const;  // before binning: the cell list needs finite coordinates
