@@ -138,7 +138,7 @@ def main():
     ax.set_ylabel("|stress_total - reference| (Pa)")
     ax.set_title(f"small scene, Mn = 1e-2, {len(seeds)} seeds, strain {warm}-{strain}; "
                  f"reference {ref_m:.0f} ± {ref_e:.0f} Pa", fontsize=8)
-    ax.legend(fontsize=7, loc="upper right")
+    ax.legend(fontsize=7, loc="lower left")
     fig.tight_layout()
     fig.savefig(os.path.join(HERE, "implicit_small_scene.png"))
     print("wrote", path_csv)

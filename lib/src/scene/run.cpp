@@ -69,7 +69,6 @@ void print_limits(const TimeStepChoice& t, const RunSummary& s, const DemParams&
                  s.reynolds_number);
 }
 
-// Running sums of one time-series row.
 // Running sums of one time-series row, each step weighted by w (1 for the
 // fixed-step schemes, the step length for the adaptive implicit one).
 struct Row {
