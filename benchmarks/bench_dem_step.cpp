@@ -1,5 +1,8 @@
 // One DEM-Stokes step of the paper scene (gap 150 um, 50 x 120 um, phi 0.30,
 // dipole cutoff 4 d), for each integrator, and the pair-force kernel alone.
+// An implicit step is one accepted, error-controlled step (rejected attempts
+// included); its counters give the Newton and CG iterations per step and the
+// mean step length, so time per strain unit = time per step / (dt gdot).
 // Counters: particle-steps/s and pair evaluations/s (pairs in the Verlet list).
 #include <benchmark/benchmark.h>
 
@@ -35,6 +38,26 @@ void BM_PaperStep(benchmark::State& state, mrf::IntegratorId scheme) {
 }
 BENCHMARK_CAPTURE(BM_PaperStep, verlet_exp, mrf::IntegratorId::verlet_exp)->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_PaperStep, overdamped, mrf::IntegratorId::overdamped)->Unit(benchmark::kMicrosecond)->UseRealTime();
+
+void BM_PaperImplicitStep(benchmark::State& state, mrf::ContactLinearSolver solver) {
+  mrf::DemModel model = paper_model(mrf::IntegratorId::implicit);
+  mrf::ImplicitOptions o;
+  o.solver = solver;
+  model.set_implicit_options(o);
+  const mrf::ImplicitCounters c0 = model.implicit_counters();
+  const long s0 = model.steps();
+  const double t0 = model.time();
+  for (auto _ : state) model.step();
+  step_counters(state, model);
+  const mrf::ImplicitCounters& c = model.implicit_counters();
+  const double steps = static_cast<double>(model.steps() - s0);
+  state.counters["newton/step"] = static_cast<double>(c.newton_iterations - c0.newton_iterations) / steps;
+  state.counters["cg/step"] = static_cast<double>(c.linear_iterations - c0.linear_iterations) / steps;
+  state.counters["rejected/step"] = static_cast<double>(c.rejected + c.newton_failures - c0.rejected - c0.newton_failures) / steps;
+  state.counters["mean_dt_s"] = (model.time() - t0) / steps;
+}
+BENCHMARK_CAPTURE(BM_PaperImplicitStep, pcg, mrf::ContactLinearSolver::pcg)->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_PaperImplicitStep, eigen_ldlt, mrf::ContactLinearSolver::eigen_ldlt)->Unit(benchmark::kMicrosecond)->UseRealTime();
 
 void BM_PaperPairForces(benchmark::State& state) {
   mrf::DemModel model = paper_model(mrf::IntegratorId::verlet_exp);

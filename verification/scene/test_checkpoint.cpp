@@ -39,7 +39,7 @@ void check_resume_reproduces(const std::string& integrator) {
 
   RunOptions cut = whole;
   cut.out_dir = (base / "cut").string();
-  cut.checkpoint_every_rows = 150;
+  cut.checkpoint_every_rows = 20;
   cut.stop_after_steps = a.steps * 2 / 3;
   EXPECT_THROW(run_scene(scene(integrator), cut), RunInterrupted);
   ASSERT_TRUE(std::filesystem::exists(base / "cut/checkpoint.bin"));
@@ -60,6 +60,7 @@ void check_resume_reproduces(const std::string& integrator) {
 
 TEST(Checkpoint, ResumedVerletRunEqualsUninterruptedBitForBit) { check_resume_reproduces("verlet_exp"); }
 TEST(Checkpoint, ResumedOverdampedRunEqualsUninterruptedBitForBit) { check_resume_reproduces("overdamped"); }
+TEST(Checkpoint, ResumedImplicitRunEqualsUninterruptedBitForBit) { check_resume_reproduces("implicit"); }
 
 // (also: checkpoints of a run without frames; an unopened frame stream once broke them)
 TEST(Checkpoint, RefusesACheckpointOfAnotherScene) {

@@ -74,7 +74,7 @@ strain = 0.3
 warmup_strain = 0.1
 
 [numerics]
-integrator = "auto"
+integrator = "verlet_exp"
 dt = "auto"
 threads = 1
 
@@ -538,33 +538,40 @@ TEST(RunIntegratorChoice, SmallSceneIsBoundByHertzContactWithVerletExp) {
   EXPECT_EQ(r.summary.dt, r.scene.config.dt_safety * smallest(ve));
 }
 
-// Auto picks the scheme whose binding (smallest) limit is largest, ties to
-// verlet_exp; dt = dt_safety times that limit.
+// Auto picks the explicit scheme whose binding (smallest) limit is largest,
+// ties to verlet_exp, with dt = dt_safety times that limit; unless that limit
+// is more than k_implicit_preference times below the implicit step bound:
+// then implicit, with dt = the bound (its largest step).
 void expect_auto_rule(const LoadedScene& s, const std::string& label) {
   const DemParams p = dem_params(s.config);
   const auto ve = dem_limits(p, s.config, IntegratorId::verlet_exp);
   const auto od = dem_limits(p, s.config, IntegratorId::overdamped);
-  const IntegratorId want =
-      smallest(ve) >= smallest(od) ? IntegratorId::verlet_exp : IntegratorId::overdamped;
+  const auto im = dem_limits(p, s.config, IntegratorId::implicit);
+  const double explicit_dt = std::max(smallest(ve), smallest(od));
+  const IntegratorId want = k_implicit_preference * explicit_dt < smallest(im) ? IntegratorId::implicit
+                            : smallest(ve) >= smallest(od)                     ? IntegratorId::verlet_exp
+                                                                               : IntegratorId::overdamped;
   const TimeStepChoice t = choose_time_step(s, p);
   EXPECT_EQ(t.scheme, want) << label << ": verlet_exp limit " << smallest(ve)
-                            << " s, overdamped limit " << smallest(od) << " s";
-  EXPECT_EQ(t.dt, s.config.dt_safety * std::max(smallest(ve), smallest(od))) << label;
-  EXPECT_EQ(binding(t.limits).name, binding(want == IntegratorId::verlet_exp ? ve : od).name)
-      << label;
+                            << " s, overdamped limit " << smallest(od) << " s, implicit bound " << smallest(im);
+  EXPECT_EQ(t.dt, want == IntegratorId::implicit ? smallest(im) : s.config.dt_safety * explicit_dt) << label;
+  const auto& limits = want == IntegratorId::implicit ? im : want == IntegratorId::verlet_exp ? ve : od;
+  EXPECT_EQ(binding(t.limits).name, binding(limits).name) << label;
 }
 
 TEST(RunIntegratorChoice, AutoPicksTheSchemeWhoseBindingLimitIsLargest) {
   for (const char* density : {"7800", "78", "7.8", "0.078"})
     for (const char* youngs : {"\"200 GPa\"", "\"2 GPa\""}) {
       const std::vector<std::string> set = {std::string("particles.density=") + density,
-                                            std::string("contact.youngs_modulus=") + youngs};
+                                            std::string("contact.youngs_modulus=") + youngs,
+                                            "numerics.integrator=auto"};
       expect_auto_rule(scene(set), set[0] + " " + set[1]);
     }
 }
 
 TEST(RunIntegratorChoice, TinyDensityRunReportsTheSchemeOfTheRule) {
-  const std::vector<std::string> set = {"particles.density=7.8", "contact.youngs_modulus=\"2 GPa\"",
+  const std::vector<std::string> set = {"particles.density=7.8", "contact.youngs_modulus=\"0.2 GPa\"",
+                                        "numerics.integrator=auto",
                                         "drive.strain=0.05", "drive.warmup_strain=0.02",
                                         "output.every=0"};
   const LoadedScene s = scene(set);

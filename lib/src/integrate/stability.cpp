@@ -64,6 +64,7 @@ namespace {
 // A free pair in contact: relative coordinate with reduced mass m/2 and the
 // same relaxation time, so omega^2 = 2 k_eff / m.
 double contact_limit(const DemParams& p, IntegratorId scheme, double k_eff) {
+  if (scheme == IntegratorId::implicit) return std::numeric_limits<double>::infinity();
   if (scheme == IntegratorId::overdamped) return overdamped_contact_limit(p.gamma, k_eff);
   return verlet_exp_oscillator_limit(std::sqrt(2.0 * k_eff / p.mass), p.tau_p);
 }
@@ -76,7 +77,7 @@ double contact_limit_at_overlap(const DemParams& p, IntegratorId scheme, double 
 
 double expected_overlap(const DemParams& p, IntegratorId scheme) {
   const double h_load = hertz_overlap_under_load(p.expected_load, p.hertz_k);
-  if (scheme == IntegratorId::overdamped) return h_load;  // no inertia: overlap follows the load
+  if (scheme != IntegratorId::verlet_exp) return h_load;  // no inertia: overlap follows the load
   return std::max(h_load, hertz_max_overlap(0.5 * p.mass, p.impact_speed, p.hertz_k));
 }
 
@@ -84,14 +85,14 @@ std::vector<StabilityLimit> dem_limits(const DemParams& p, const SceneConfig& c,
   constexpr double inf = std::numeric_limits<double>::infinity();
   std::vector<StabilityLimit> out;
   const double h = expected_overlap(p, scheme);
+  const bool inertial = scheme == IntegratorId::verlet_exp;
   out.push_back({"hertz contact", contact_limit_at_overlap(p, scheme, h),
-                 "expected overlap/R " + fmt(h / p.radius) + " (load " + fmt(p.expected_load) +
-                     " N" + (scheme == IntegratorId::overdamped ? "" : ", impact at " + fmt(p.impact_speed) + " m/s") +
-                     ")"});
+                 (scheme == IntegratorId::implicit ? "backward Euler contacts, no limit; expected overlap/R "
+                                                   : "expected overlap/R ") +
+                     fmt(h / p.radius) + " (load " + fmt(p.expected_load) + " N" +
+                     (inertial ? ", impact at " + fmt(p.impact_speed) + " m/s" : "") + ")"});
   out.push_back({"drag relaxation", inf,
-                 "tau_p = " + fmt(p.tau_p) +
-                     (scheme == IntegratorId::overdamped ? " s (inertia neglected)"
-                                                         : " s (integrated exactly)")});
+                 "tau_p = " + fmt(p.tau_p) + (inertial ? " s (integrated exactly)" : " s (inertia neglected)")});
   // Accuracy bounds: a contact pair under the head-to-tail force, or a wall
   // sphere, moves at most 5 % of R per step.
   constexpr double k_frac = 0.05;
@@ -105,6 +106,14 @@ std::vector<StabilityLimit> dem_limits(const DemParams& p, const SceneConfig& c,
 }
 
 double smallest(const std::vector<StabilityLimit>& limits) { return binding(limits).dt; }
+
+IntegratorId auto_integrator(const std::vector<StabilityLimit>& verlet_exp,
+                             const std::vector<StabilityLimit>& overdamped,
+                             const std::vector<StabilityLimit>& implicit) {
+  const double explicit_dt = std::max(smallest(verlet_exp), smallest(overdamped));
+  if (k_implicit_preference * explicit_dt < smallest(implicit)) return IntegratorId::implicit;
+  return smallest(verlet_exp) >= smallest(overdamped) ? IntegratorId::verlet_exp : IntegratorId::overdamped;
+}
 
 const StabilityLimit& binding(const std::vector<StabilityLimit>& limits) {
   return *std::min_element(limits.begin(), limits.end(),

@@ -1,5 +1,6 @@
 // DemModel checkpoints: every member that carries state from one step to the
-// next. Scratch (force buffers, drift velocities of a step) is not saved.
+// next. Scratch (force buffers, drift velocities, the implicit scheme's
+// contact candidates and Newton work arrays, all rebuilt each step) is not saved.
 #include "mrf/scene/dem_model.hpp"
 
 namespace mrf {
@@ -20,6 +21,9 @@ void DemModel::save(ArchiveWriter& out) const {
   out.put(sums_);
   out.put(time_);
   out.put(steps_);
+  out.put(dt_);  // implicit scheme: the step just taken, the next try and the work so far
+  out.put(dt_try_);
+  out.put(counters_);
 }
 
 void DemModel::load(ArchiveReader& in) {
@@ -44,6 +48,9 @@ void DemModel::load(ArchiveReader& in) {
   in.get(sums_);
   in.get(time_);
   in.get(steps_);
+  in.get(dt_);
+  in.get(dt_try_);
+  in.get(counters_);
 }
 
 }  // namespace mrf

@@ -1,7 +1,9 @@
 #include "mrf/scene/dem_model.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <string>
 
 #include "mrf/error.hpp"
 #include "mrf/forces/hertz.hpp"
@@ -9,16 +11,27 @@
 
 namespace mrf {
 
+namespace {
+// Contact candidates of an implicit step are the pairs within 2R + margin at
+// x_n; a step that moves a particle (or the walls) by more than margin/2 is
+// rejected, so no contact can be missed. Lists are built with this reach.
+constexpr double k_margin_over_radius = 0.2;
+// A step shorter than this fraction of the largest allowed one is a failure.
+constexpr double k_dt_floor = 1e-7;
+}  // namespace
+
 DemModel::DemModel(ShearCell cell, const DemParams& params, IntegratorId scheme, double dt)
-    : cell_(std::move(cell)), p_(params), scheme_(scheme), dt_(dt) {
-  if (scheme_ != IntegratorId::verlet_exp && scheme_ != IntegratorId::overdamped)
-    throw InputError("numerics.integrator", to_string(scheme_), "", "not available for dem_stokes yet");
+    : cell_(std::move(cell)), p_(params), scheme_(scheme), dt_(dt), dt_max_(dt), dt_try_(0.1 * dt) {
+  if (scheme_ == IntegratorId::automatic)
+    throw InputError("numerics.integrator", to_string(scheme_), "", "choose the integrator before building the model");
   cell_.free.v.resize(cell_.free.size(), Vec3::Zero());
   cell_.free.f.resize(cell_.free.size(), Vec3::Zero());
   const double two_r = 2.0 * p_.radius;
-  const double ff_range = p_.dipole_pref > 0 ? std::max(p_.dipole_cutoff, two_r) : two_r;
-  lists_ = make_pair_lists(ff_range, cell_.walls.size() > 0 ? two_r : 0.0, p_.skin);
-  overlap_limit_ = critical_overlap(p_, scheme_, dt_);
+  const double contact_reach =
+      scheme_ == IntegratorId::implicit ? two_r + k_margin_over_radius * p_.radius : two_r;
+  const double ff_range = p_.dipole_pref > 0 ? std::max(p_.dipole_cutoff, contact_reach) : contact_reach;
+  lists_ = make_pair_lists(ff_range, cell_.walls.size() > 0 ? contact_reach : 0.0, p_.skin);
+  overlap_limit_ = scheme_ == IntegratorId::implicit ? p_.radius : critical_overlap(p_, scheme_, dt_);
   update_forces();
 }
 
@@ -32,6 +45,7 @@ void DemModel::update_forces() {
 }
 
 void DemModel::step() {
+  if (scheme_ == IntegratorId::implicit) return implicit_step();
   auto& f = cell_.free;
   if (scheme_ == IntegratorId::verlet_exp) {
     exp_verlet_advance(f.x, f.v, f.f, w_, p_.tau_p, p_.gamma, p_.shear_rate, dt_);
@@ -45,6 +59,99 @@ void DemModel::step() {
   update_forces();
   if (scheme_ == IntegratorId::verlet_exp)
     exp_verlet_correct(f.x, f.v, f.f, w_, p_.tau_p, p_.gamma, p_.shear_rate, dt_);
+}
+
+// One try of an IMEX Euler step of length dt from x0_ (explicit drift in w_):
+// Newton for y = b + (dt/gamma) F_c(y), b = x_n + dt w, walls at t_{n+1}.
+// Leaves y in free.x; returns the Newton result, the error estimate (half the
+// largest distance from the predictor x_n + dt v_n) and the largest displacement.
+DemModel::Attempt DemModel::attempt(double dt, const NewtonOptions& nopt) {
+  auto& f = cell_.free;
+  const std::size_t n = f.size();
+  const double dt_over_gamma = dt / p_.gamma;
+  b_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    b_[i] = x0_[i] + dt * w_[i];
+    f.x[i] = x0_[i] + dt * f.v[i];  // predictor
+  }
+  cell_.walls.x = walls0_;
+  move_walls(cell_.walls, p_.shear_rate, dt);
+  // Newton starts from the predictor or from x_n, whichever is lower in the
+  // merit function: after a sudden change (a contact made or broken) the
+  // extrapolated slope can throw the predictor far off.
+  const double phi_pred = newton_.merit(candidates_, b_, cell_.walls, cell_.box, p_.radius, p_.hertz_k, dt_over_gamma, f.x);
+  if (newton_.merit(candidates_, b_, cell_.walls, cell_.box, p_.radius, p_.hertz_k, dt_over_gamma, x0_) < phi_pred)
+    f.x = x0_;
+  Attempt a;
+  a.newton = newton_.solve(candidates_, b_, cell_.walls, cell_.box, p_.radius, p_.hertz_k, dt_over_gamma, nopt, f.x);
+  counters_.newton_iterations += a.newton.iterations;
+  counters_.linear_iterations += a.newton.linear_iterations;
+  for (std::size_t i = 0; i < n; ++i) {
+    a.error = std::max(a.error, 0.5 * (f.x[i] - x0_[i] - dt * f.v[i]).norm());
+    const double d = (f.x[i] - x0_[i]).norm();
+    if (d > a.displacement) a.displacement = d, a.moved = static_cast<std::uint32_t>(i);
+  }
+  return a;
+}
+
+// IMEX Euler (REFERENCE §3, contacts implicit), one accepted step:
+//   y = x_n + dt (u(x_n) + F_nc(x_n)/gamma) + (dt/gamma) F_c(y),
+// error-controlled (ImplicitOptions): a step is retried shorter when Newton
+// fails (dt/4), a particle or the walls move more than half the contact
+// margin (dt/2), or the error estimate exceeds the tolerance.
+void DemModel::implicit_step() {
+  auto& f = cell_.free;
+  const double r = p_.radius, margin = k_margin_over_radius * r;
+  const double wall_speed = std::abs(p_.shear_rate) * 0.5 * cell_.box.gap;
+  contact_candidates(lists_, f.x, cell_.walls, cell_.box, r, margin, candidates_);
+  contact_forces(candidates_, f.x, cell_.walls, cell_.box, r, p_.hertz_k, fc_);
+  x0_ = f.x;
+  walls0_ = cell_.walls.x;
+  w_.resize(f.size());  // explicit drift u(x_n) + F_nc(x_n)/gamma, F_nc = F - F_c
+  for (std::size_t i = 0; i < f.size(); ++i)
+    w_[i] = drift_velocity(x0_[i], f.f[i] - fc_[i], 1.0 / p_.gamma, p_.shear_rate);
+  const NewtonOptions nopt{opt_.newton_tol_over_radius * r, opt_.max_newton, opt_.linear_rtol, opt_.solver};
+  // Land on the stop time without leaving a sliver for the next step.
+  const double remaining = stop_time_ - time_;
+  double dt = opt_.fixed_step ? dt_max_ : dt_try_;
+  if (!opt_.fixed_step && remaining > 0 && remaining < 1.5 * dt_try_)
+    dt = remaining <= dt_max_ ? remaining : 0.5 * remaining;
+  const double dt_floor = k_dt_floor * std::min(dt, dt_max_);
+  for (;;) {
+    const Attempt a = attempt(dt, nopt);
+    const bool too_far = a.displacement > 0.5 * margin || wall_speed * dt > 0.5 * margin;
+    const double ratio = a.error / (opt_.tol_over_radius * r);
+    if (opt_.fixed_step && (!a.newton.converged || too_far)) {
+      std::ostringstream m;
+      m << "implicit fixed step " << dt << " s failed at step " << steps_ << " (t = " << time_ << " s): "
+        << (a.newton.converged ? "particle " + std::to_string(a.moved) + " moved " + std::to_string(a.displacement / r) +
+                                     " R, more than half the contact margin"
+                               : "Newton did not converge; largest correction at particle " +
+                                     std::to_string(a.newton.worst));
+      throw NumericalError(m.str());
+    }
+    if (a.newton.converged && !too_far && (ratio <= 1.0 || opt_.fixed_step)) {
+      for (std::size_t i = 0; i < f.size(); ++i) f.v[i] = (f.x[i] - x0_[i]) / dt;
+      dt_try_ = std::min(dt_max_, dt * std::min(2.0, 0.9 / std::sqrt(std::max(ratio, 1e-6))));
+      break;
+    }
+    ++(a.newton.converged ? counters_.rejected : counters_.newton_failures);
+    dt *= !a.newton.converged ? 0.25 : too_far ? 0.5 : std::max(0.2, 0.9 / std::sqrt(ratio));
+    if (!(dt >= dt_floor)) {
+      std::ostringstream m;
+      m << "implicit step failed at step " << steps_ << " (t = " << time_ << " s): the step size fell to " << dt
+        << " s (below " << k_dt_floor << " of numerics.dt " << dt_max_ << " s) without meeting the error tolerance"
+        << " or a converged Newton solve; last Newton correction largest at particle " << a.newton.worst;
+      throw NumericalError(m.str());
+    }
+  }
+  dt_ = dt;
+  counters_.dt_min = std::min(counters_.dt_min, dt);
+  counters_.dt_max = std::max(counters_.dt_max, dt);
+  lists_.wall_travel += wall_speed * dt;
+  time_ += dt;
+  ++steps_;
+  update_forces();
 }
 
 void DemModel::check_finite_positions() const {

@@ -24,19 +24,14 @@ TimeStepChoice choose_time_step(const LoadedScene& scene, const DemParams& p) {
   const SceneConfig& c = scene.config;
   auto ve = dem_limits(p, c, IntegratorId::verlet_exp);
   auto od = dem_limits(p, c, IntegratorId::overdamped);
+  auto im = dem_limits(p, c, IntegratorId::implicit);
   TimeStepChoice t{};
-  switch (c.integrator) {
-    case IntegratorId::verlet_exp: t.scheme = IntegratorId::verlet_exp; break;
-    case IntegratorId::overdamped: t.scheme = IntegratorId::overdamped; break;
-    case IntegratorId::automatic:
-      t.scheme = smallest(ve) >= smallest(od) ? IntegratorId::verlet_exp : IntegratorId::overdamped;
-      break;
-    case IntegratorId::implicit:
-      throw InputError("numerics.integrator", "implicit", scene.locate("numerics.integrator"),
-                       "the implicit integrator is not implemented yet (issue #7)");
+  t.scheme = c.integrator == IntegratorId::automatic ? auto_integrator(ve, od, im) : c.integrator;
+  switch (t.scheme) {
+    case IntegratorId::verlet_exp: t.limits = ve, t.other = od; break;
+    case IntegratorId::overdamped: t.limits = od, t.other = ve; break;
+    default: t.limits = im, t.other = smallest(ve) >= smallest(od) ? ve : od; break;
   }
-  t.limits = t.scheme == IntegratorId::verlet_exp ? ve : od;
-  t.other = t.scheme == IntegratorId::verlet_exp ? od : ve;
   const StabilityLimit& b = binding(t.limits);
   if (c.dt) {
     if (*c.dt > b.dt) {
@@ -49,40 +44,46 @@ TimeStepChoice choose_time_step(const LoadedScene& scene, const DemParams& p) {
     }
     t.dt = *c.dt;
   } else {
-    t.dt = c.dt_safety * b.dt;
+    // implicit: the bound is the largest step of an error-controlled scheme, not a stability limit
+    t.dt = t.scheme == IntegratorId::implicit ? b.dt : c.dt_safety * b.dt;
   }
   return t;
 }
 
 namespace {
 
-void print_limits(const TimeStepChoice& t, const RunSummary& s) {
+// The limits of every DEM integrator, the one that binds each, and the choice.
+void print_limits(const TimeStepChoice& t, const RunSummary& s, const DemParams& p, const SceneConfig& c) {
   std::fprintf(stderr, "mrf: %s, Mn = %.4g (9 eta gdot / 2 mu0 M^2), gdot = %.4g 1/s\n",
                s.model.c_str(), s.mason, s.shear_rate);
-  auto table = [](const char* scheme, const std::vector<StabilityLimit>& l) {
+  for (IntegratorId id : {IntegratorId::verlet_exp, IntegratorId::overdamped, IntegratorId::implicit}) {
+    const auto l = dem_limits(p, c, id);
     for (const auto& x : l)
-      std::fprintf(stderr, "  %-11s %-20s dt < %-10.3g  %s\n", scheme, x.name.c_str(), x.dt, x.basis.c_str());
-  };
-  table(to_string(t.scheme), t.limits);
-  table(to_string(t.scheme == IntegratorId::verlet_exp ? IntegratorId::overdamped : IntegratorId::verlet_exp),
-        t.other);
-  std::fprintf(stderr, "  chosen: %s, dt = %.4g s (bound by '%s'), %ld steps; St = %.3g, Re_p = %.3g\n",
-               to_string(t.scheme), t.dt, binding(t.limits).name.c_str(), s.steps, s.stokes_number,
-               s.reynolds_number);
+      std::fprintf(stderr, "  %-11s %-20s dt < %-10.3g  %s\n", to_string(id), x.name.c_str(), x.dt, x.basis.c_str());
+    std::fprintf(stderr, "  %-11s bound by '%s' (dt < %.3g s)\n", to_string(id), binding(l).name.c_str(), smallest(l));
+  }
+  if (t.scheme == IntegratorId::implicit)
+    std::fprintf(stderr, "  chosen: implicit, error-controlled dt <= %.4g s (bound by '%s'); St = %.3g, Re_p = %.3g\n",
+                 t.dt, binding(t.limits).name.c_str(), s.stokes_number, s.reynolds_number);
+  else
+    std::fprintf(stderr, "  chosen: %s, dt = %.4g s (bound by '%s'), %ld steps; St = %.3g, Re_p = %.3g\n",
+                 to_string(t.scheme), t.dt, binding(t.limits).name.c_str(), s.steps, s.stokes_number,
+                 s.reynolds_number);
 }
 
-// Running sums of one time-series row.
+// Running sums of one time-series row, each step weighted by w (1 for the
+// fixed-step schemes, the step length for the adaptive implicit one).
 struct Row {
   double tau_p = 0, vir_mag = 0, vir_con = 0, max_overlap = 0, e_dip = 0, e_hertz = 0;
-  int n = 0;
-  void add(const PairSums& p, const Box& box) {
-    tau_p += wall_shear_stress(p.wall_fz, box);
-    vir_mag += virial_shear_stress(p.virial_mag_xz, box);
-    vir_con += virial_shear_stress(p.virial_con_xz, box);
+  double n = 0;
+  void add(const PairSums& p, const Box& box, double w) {
+    tau_p += w * wall_shear_stress(p.wall_fz, box);
+    vir_mag += w * virial_shear_stress(p.virial_mag_xz, box);
+    vir_con += w * virial_shear_stress(p.virial_con_xz, box);
     max_overlap = std::max(max_overlap, p.max_overlap);
-    e_dip += p.energy_dipole;
-    e_hertz += p.energy_hertz;
-    ++n;
+    e_dip += w * p.energy_dipole;
+    e_hertz += w * p.energy_hertz;
+    n += w;
   }
 };
 
@@ -93,6 +94,8 @@ struct Series {
 // What the DEM run loop carries from one row to the next (checkpointed).
 struct LoopState {
   long n = 0;                 // last completed step
+  double row_start = 0;       // time at which the current row began (s)
+  double strain_before = 0;   // strain reached by earlier sessions of this run
   Series se;
   double max_overlap = 0;
   long pair_evals = 0;
@@ -100,6 +103,8 @@ struct LoopState {
   std::uint64_t ts_bytes = 0, frames_bytes = 0;
   void save(ArchiveWriter& a) const {
     a.put(n);
+    a.put(row_start);
+    a.put(strain_before);
     for (const auto* v : {&se.total, &se.particles, &se.virial, &se.mag, &se.con, &se.diff}) a.put(*v);
     a.put(max_overlap);
     a.put(pair_evals);
@@ -109,6 +114,8 @@ struct LoopState {
   }
   void load(ArchiveReader& a) {
     a.get(n);
+    a.get(row_start);
+    a.get(strain_before);
     for (auto* v : {&se.total, &se.particles, &se.virial, &se.mag, &se.con, &se.diff}) a.get(*v);
     a.get(max_overlap);
     a.get(pair_evals);
@@ -240,9 +247,14 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
 
   RunSummary s = dem_summary_header(c, p, ts, cell);
   s.extra.insert({{"dipole_cutoff", c.dipole_cutoff}, {"gap", c.gap}, {"box_ly", c.ly}, {"box_lz", c.lz}});
-  if (!opt.quiet) print_limits(ts, s);
+  if (!opt.quiet) print_limits(ts, s, p, c);
 
   DemModel model(std::move(cell), p, ts.scheme, ts.dt);
+  // The implicit scheme chooses its steps: it runs to the end time and writes
+  // a row every `every` steps of its largest dt, i.e. by strain interval.
+  const bool adaptive = ts.scheme == IntegratorId::implicit;
+  const double t_end = c.strain / c.shear_rate;
+  if (adaptive) model.set_stop_time(t_end);
   const long every = c.every > 0 ? c.every : std::max(1L, s.steps / 2000);
   const double rows_after_warmup = (1.0 - c.warmup_strain / c.strain) * static_cast<double>(s.steps / every);
   if (rows_after_warmup < 32)
@@ -291,12 +303,17 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();
   auto last_report = t0, last_checkpoint = t0;
   long rows_since_checkpoint = 0;
-  for (long n = st.n + 1; n <= s.steps; ++n) {
+  const double row_time = static_cast<double>(every) * ts.dt;
+  long n = st.n;
+  auto running = [&] { return adaptive ? model.time() < t_end * (1 - 1e-12) : n < s.steps; };
+  while (running()) {
+    ++n;
     model.step();
-    row.add(model.sums(), model.cell().box);
+    row.add(model.sums(), model.cell().box, adaptive ? model.dt() : 1.0);
     st.pair_evals += model.sums().pair_evaluations;
     if (frame_every > 0 && n % frame_every == 0 && frames_out.is_open()) write_frame(frames_out, model.cell(), p.radius, model.time());
-    if (n % every != 0 && n != s.steps) continue;
+    const bool row_due = adaptive ? model.time() >= st.row_start + row_time * (1 - 1e-9) : n % every == 0;
+    if (!row_due && running()) continue;
     const double k = 1.0 / row.n, strain = model.time() * c.shear_rate;
     const double tp = row.tau_p * k, vm = row.vir_mag * k, vc = row.vir_con * k;
     st.max_overlap = std::max(st.max_overlap, row.max_overlap);
@@ -304,7 +321,8 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
       ts_out << model.time() << "," << strain << "," << tp + s.stress_fluid << "," << tp << ","
              << s.stress_fluid << "," << vm << "," << vc << "," << row.max_overlap / p.radius << ","
              << row.e_dip * k << "," << row.e_hertz * k << "\n";
-    if (strain - row.n * ts.dt * c.shear_rate >= c.warmup_strain) {  // whole row after warm-up
+    if ((adaptive ? st.row_start * c.shear_rate : strain - row.n * ts.dt * c.shear_rate) >=
+        c.warmup_strain) {  // whole row after warm-up
       st.se.total.push_back(tp + s.stress_fluid);
       st.se.particles.push_back(tp);
       st.se.virial.push_back(vm + vc);
@@ -313,15 +331,17 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
       st.se.diff.push_back(tp - vm - vc);
     }
     row = Row{};
+    st.row_start = model.time();
     const auto now = std::chrono::steady_clock::now();
     ++rows_since_checkpoint;
     const bool due = opt.checkpoint_every_rows > 0
                          ? rows_since_checkpoint >= opt.checkpoint_every_rows
                          : opt.checkpoint_seconds > 0 &&
                                std::chrono::duration<double>(now - last_checkpoint).count() > opt.checkpoint_seconds;
-    if (!checkpoint.empty() && due && n < s.steps) {
+    if (!checkpoint.empty() && due && running()) {
       LoopState snap = st;
       snap.n = n;
+      snap.strain_before = strain;
       snap.elapsed_before += std::chrono::duration<double>(now - t0).count();
       ts_out.flush();
       snap.ts_bytes = static_cast<std::uint64_t>(std::filesystem::file_size(opt.out_dir + "/timeseries.csv"));
@@ -342,12 +362,23 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
     if (!opt.quiet && std::chrono::duration<double>(now - last_report).count() > 2.0) {
       last_report = now;
       const double el = std::chrono::duration<double>(now - t0).count();
-      const double done = static_cast<double>(n - st.n);
-      std::fprintf(stderr, "\r  strain %.3f / %.3f  %.3g steps/s  ETA %.0f s   ", strain, c.strain, done / el,
-                   el * static_cast<double>(s.steps - n) / done);
+      const double done_strain = strain - st.strain_before;
+      std::fprintf(stderr, "\r  strain %.3f / %.3f  %.3g steps/s  ETA %.0f s   ", strain, c.strain,
+                   static_cast<double>(n - st.n) / el, el * (c.strain - strain) / done_strain);
     }
   }
   s.wall_seconds = st.elapsed_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  s.steps = n;
+  if (adaptive) {
+    const ImplicitCounters& ic = model.implicit_counters();
+    s.extra["implicit_rejected_steps"] = static_cast<double>(ic.rejected);
+    s.extra["implicit_newton_failures"] = static_cast<double>(ic.newton_failures);
+    s.extra["implicit_newton_iterations"] = static_cast<double>(ic.newton_iterations);
+    s.extra["implicit_linear_iterations"] = static_cast<double>(ic.linear_iterations);
+    s.extra["implicit_dt_min"] = ic.dt_min;
+    s.extra["implicit_dt_max"] = ic.dt_max;
+    s.extra["implicit_dt_mean"] = t_end / static_cast<double>(n);
+  }
   if (!opt.quiet) std::fprintf(stderr, "\r  done: %ld steps in %.1f s%30s\n", s.steps, s.wall_seconds, "");
   s.stress_total = measure(st.se.total);
   s.stress_particles = measure(st.se.particles);

@@ -32,13 +32,29 @@ double overdamped_contact_limit(double gamma, double k_eff);
 // impact at the expected approach speed (REFERENCE TEST 2.1).
 double expected_overlap(const DemParams& p, IntegratorId scheme);
 
-// All limits of a DEM scene for the given scheme (verlet_exp or overdamped).
+// All limits of a DEM scene for the given scheme. For `implicit` the contact
+// and drag limits are infinite and the binding one is an accuracy bound (the
+// magnetic or shear motion per step): the largest step the error control may take.
 std::vector<StabilityLimit> dem_limits(const DemParams& p, const SceneConfig& c, IntegratorId scheme);
 
 // Contact limit for the largest overlap actually seen (checked during a run).
 double contact_limit_at_overlap(const DemParams& p, IntegratorId scheme, double overlap);
 
 double smallest(const std::vector<StabilityLimit>& limits);
+
+// Automatic choice of the integrator (numerics.integrator = "auto"): the
+// explicit scheme whose binding limit is largest (ties to verlet_exp), unless
+// that limit is more than k_implicit_preference times below the implicit
+// step bound (the magnetic / shear accuracy limit), then `implicit`. The
+// factor is the measured break-even on the small scene at 200 GPa: the
+// error-controlled steps average 0.9 of the bound, explicit runs at
+// dt_safety = 0.5 of its limit, and one implicit step costs about 12
+// explicit ones (reports/work_precision/README.md), so implicit wins above
+// a limit ratio of about 6.7.
+inline constexpr double k_implicit_preference = 8.0;
+IntegratorId auto_integrator(const std::vector<StabilityLimit>& verlet_exp,
+                             const std::vector<StabilityLimit>& overdamped,
+                             const std::vector<StabilityLimit>& implicit);
 const StabilityLimit& binding(const std::vector<StabilityLimit>& limits);
 
 // Largest overlap (m) whose Hertz stiffness the scheme still integrates

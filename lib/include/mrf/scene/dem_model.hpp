@@ -3,7 +3,13 @@
 //  verlet_exp  exponential velocity Verlet: drag exact over the step,
 //              forces linear in time (integrate/steps.hpp)
 //  overdamped  v = u(x) + F/gamma, x += v dt   (inertialess, first order)
+//  implicit    inertialess, Hertz contacts backward Euler, dipole and flow
+//              explicit (integrate/implicit_contact.hpp); the step size is
+//              chosen from a local error estimate, up to the dt given.
 #pragma once
+#include <limits>
+
+#include "mrf/integrate/implicit_contact.hpp"
 #include "mrf/integrate/stability.hpp"
 #include "mrf/io/archive.hpp"
 #include "mrf/scene/dem_forces.hpp"
@@ -11,11 +17,40 @@
 
 namespace mrf {
 
+// Accuracy control of the implicit scheme. The local error of a step is
+// estimated as half the distance between the corrector (backward Euler) and
+// the predictor x_n + dt v_n (v_n the slope of the previous step), i.e.
+// (dt/2)|v_{n+1} - v_n| ~ (dt^2/2)|x''|, the leading error term of IMEX Euler.
+struct ImplicitOptions {
+  double tol_over_radius = 1e-2;         // largest local error per step / R
+  double newton_tol_over_radius = 1e-6;  // largest Newton correction at convergence / R
+  double linear_rtol = 1e-1;             // relative residual of each linear solve (inexact Newton)
+  int max_newton = 20;                   // iterations before the step is retried at dt/4
+  bool fixed_step = false;               // every step = the dt given (convergence tests); no error control
+  ContactLinearSolver solver = ContactLinearSolver::pcg;
+};
+
+// Work of the implicit scheme since construction.
+struct ImplicitCounters {
+  long rejected = 0;           // steps rejected by the error test or the displacement bound
+  long newton_failures = 0;    // steps rejected because Newton did not converge
+  long newton_iterations = 0;  // over all attempts
+  long linear_iterations = 0;  // CG iterations (1 per Newton iteration for the direct solver)
+  double dt_min = std::numeric_limits<double>::infinity(), dt_max = 0;  // accepted steps (s)
+};
+
 class DemModel {
  public:
   DemModel(ShearCell cell, const DemParams& params, IntegratorId scheme, double dt);
 
+  // One (accepted) step. For the implicit scheme dt() is the step just taken
+  // and the next one is chosen by the error control, at most max_dt().
   void step();
+  void set_implicit_options(const ImplicitOptions& o) { opt_ = o; }
+  // The implicit scheme shortens the step that would pass t (s) to end on it.
+  void set_stop_time(double t) { stop_time_ = t; }
+  const ImplicitCounters& implicit_counters() const { return counters_; }
+  double max_dt() const { return dt_max_; }
 
   const ShearCell& cell() const { return cell_; }
   const DemParams& params() const { return p_; }
@@ -36,6 +71,13 @@ class DemModel {
 
  private:
   void update_forces();
+  void implicit_step();
+  struct Attempt {
+    NewtonResult newton;
+    double error = 0, displacement = 0;  // m
+    std::uint32_t moved = 0;             // particle with the largest displacement
+  };
+  Attempt attempt(double dt, const NewtonOptions& nopt);
   void check_finite_positions() const;  // before binning: the cell list needs finite coordinates
   void check_finite() const;
 
@@ -50,6 +92,13 @@ class DemModel {
   double time_ = 0;
   long steps_ = 0;
   double overlap_limit_;
+  // implicit scheme
+  ImplicitOptions opt_;
+  ImplicitCounters counters_;
+  double dt_max_, dt_try_, stop_time_ = std::numeric_limits<double>::infinity();
+  ContactNewton newton_;
+  std::vector<ContactPair> candidates_;
+  std::vector<Vec3> x0_, b_, fc_, walls0_;
 };
 
 }  // namespace mrf
