@@ -224,6 +224,9 @@ def main(argv):
                        f"that is Mn < {t['mason_10']:.3g} (20 %: Mn < {t['mason_20']:.3g}). "
                        f"`mrf criterion RUN_DIR --thresholds FILE` prints the verdict for one DEM-Stokes run."]
     for h in heldout:
+        if not os.path.exists(os.path.join(h, "criterion.json")):
+            md += ["", f"### Held-out conditions: `{h}`: no criterion.json (sweep or thresholds missing)"]
+            continue
         hc = json.load(open(os.path.join(h, "criterion.json")))
         v = hc.get("verdicts", {})
         md += ["", f"### Held-out conditions: `{os.path.basename(os.path.normpath(h))}`", "",

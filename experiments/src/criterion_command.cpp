@@ -41,7 +41,11 @@ Thresholds read_thresholds(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw mrf::InputError("--thresholds", path, "", "cannot open the thresholds file");
   const auto j = nlohmann::json::parse(in);
-  return {j.at("share_10").get<double>(), j.at("share_20").get<double>(), path};
+  // a thresholds file, or the criterion.json of a sweep that derived them
+  const auto& t = j.contains("derived_thresholds") ? j["derived_thresholds"] : j;
+  if (!t.contains("share_10") || !t.contains("share_20"))
+    throw mrf::InputError("--thresholds", path, "", "has no share_10/share_20 (and no derived_thresholds)");
+  return {t["share_10"].get<double>(), t["share_20"].get<double>(), path};
 }
 
 void print_verdict(const char* what, double share, const Thresholds& t) {

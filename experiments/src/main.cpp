@@ -46,12 +46,18 @@ int export_lammps(const std::string& scene_path, const std::vector<std::string>&
   return 0;
 }
 
-int sweep_command(const std::string& sweep_path, std::string out, bool quiet, bool estimate_only) {
+int sweep_command(const std::string& sweep_path, std::string out, bool quiet, bool estimate_only, int rank,
+                  int ranks) {
   const mrf::SweepSpec spec = mrf::load_sweep(sweep_path);
   if (out.empty()) out = "out/sweeps/" + std::filesystem::path(sweep_path).stem().string();
   mrf::SweepOptions opt;
   opt.quiet = quiet;
   opt.rank = mrf::rank_from_environment();
+  if (ranks > 0) {
+    if (rank < 0 || rank >= ranks)
+      throw mrf::InputError("--rank", std::to_string(rank), "", "must be in [0, --ranks)");
+    opt.rank = {rank, ranks};
+  }
   if (estimate_only) {
     const auto points = mrf::sweep_points(spec);
     double total = 0;
@@ -99,6 +105,9 @@ int main(int argc, char** argv) {
   sw->add_option("--out", sweep_out, "output directory (default out/sweeps/<sweep name>)");
   sw->add_flag("--quiet", sweep_quiet, "no progress on stderr");
   sw->add_flag("--estimate", sweep_estimate, "print the estimated cost of every point and stop");
+  int sweep_rank = 0, sweep_ranks = 0;
+  sw->add_option("--rank", sweep_rank, "run the share of rank R (0-based) of --ranks K; default: from mpirun, else all");
+  sw->add_option("--ranks", sweep_ranks, "number of shares the grid is split into (round-robin)");
   auto* cr = app.add_subcommand("criterion", "flow-curve fits, deviation from model 3 and the model-1 verdict");
   std::string cr_path, cr_thresholds;
   cr->add_option("path", cr_path, "a sweep output directory (sweep.csv) or a dem_stokes run directory (summary.json)")
@@ -110,7 +119,7 @@ int main(int argc, char** argv) {
     if (*run) return run_command(scene, sets, out, quiet, resume, checkpoint_seconds);
     if (*exp) return export_lammps(exp_scene, exp_sets, exp_out);
     if (*cr) return criterion_command(cr_path, cr_thresholds);
-    if (*sw) return sweep_command(sweep_file, sweep_out, sweep_quiet, sweep_estimate);
+    if (*sw) return sweep_command(sweep_file, sweep_out, sweep_quiet, sweep_estimate, sweep_rank, sweep_ranks);
   } catch (const mrf::InputError& e) {
     std::fprintf(stderr, "mrf: error: %s\n", e.what());
     return 2;

@@ -141,3 +141,20 @@ TEST(Sweep, KilledSweepResumesAndReproduces) {
 
 }  // namespace
 }  // namespace mrf
+
+namespace mrf {
+namespace {
+
+TEST(Sweep, FailedPointCountsAsFinishedUntilItsFolderIsDeleted) {
+  const auto d = std::filesystem::temp_directory_path() / "mrf_test_point";
+  std::filesystem::remove_all(d);
+  std::filesystem::create_directories(d);
+  EXPECT_FALSE(point_finished(d.string()));
+  std::ofstream(d / "summary.json.tmp") << "{";
+  EXPECT_FALSE(point_finished(d.string()));  // a half-written summary does not count
+  std::ofstream(d / "failure.json") << "{}";
+  EXPECT_TRUE(point_finished(d.string()));
+}
+
+}  // namespace
+}  // namespace mrf

@@ -195,7 +195,8 @@ RankInfo rank_from_environment() {
 }
 
 bool point_finished(const std::string& point_dir) {
-  return std::filesystem::exists(std::filesystem::path(point_dir) / "summary.json");
+  const std::filesystem::path d(point_dir);
+  return std::filesystem::exists(d / "summary.json") || std::filesystem::exists(d / "failure.json");
 }
 
 std::string sweep_csv(const std::vector<SweepPoint>& points, const std::string& out_dir) {

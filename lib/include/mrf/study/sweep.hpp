@@ -69,7 +69,8 @@ struct RankInfo {
 };
 RankInfo rank_from_environment();
 
-// A point is finished when its summary.json exists (written last, atomically).
+// A point is finished when its summary.json (written last, atomically) or its
+// failure.json exists; delete the folder of a failed point to run it again.
 bool point_finished(const std::string& point_dir);
 
 // sweep.csv text: one row per point of `points` that has a summary.json or a
