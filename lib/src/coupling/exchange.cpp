@@ -14,16 +14,37 @@ namespace mrf {
 std::vector<CouplingPair> coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x,
                                          const Box& box, double h) {
   if (!(h > 0.0)) throw std::invalid_argument("coupling_pairs: smoothing length h must be > 0");
-  const double rc = k_kernel_support * h;
-  if (box.ly < 2.0 * rc || box.lz < 2.0 * rc)
-    throw std::invalid_argument("coupling_pairs: ly and lz must be >= 4h (one periodic image per pair)");
-  const std::vector<IndexPair> idx = cross_pairs(dem_x, sph_x, box, rc);
-  std::vector<CouplingPair> out;
-  out.reserve(idx.size());
-  for (const auto& [i, a] : idx) {
-    const double r = box.min_image(dem_x[i] - sph_x[a]).norm();
-    out.push_back({i, a, kernel_w(r, h)});
+  const double rc = k_kernel_support * h, rc2 = rc * rc;
+  // Every periodic image closer than rc is its own entry: along y (z) a
+  // second image can interact only when ly (lz) < 2 rc = 4h.
+  const int ky = box.ly < 2.0 * rc ? 1 : 0, kz = box.lz < 2.0 * rc ? 1 : 0;
+  double x_lo = 0.0, x_hi = 0.0;
+  for (const Vec3& p : sph_x) {
+    x_lo = std::min(x_lo, p.x());
+    x_hi = std::max(x_hi, p.x());
   }
+  for (const Vec3& p : dem_x) {
+    x_lo = std::min(x_lo, p.x());
+    x_hi = std::max(x_hi, p.x());
+  }
+  CellGrid grid(box, x_lo - rc, x_hi + rc, rc);
+  grid.bin(sph_x);
+  std::vector<CouplingPair> out;
+  out.reserve(dem_x.size() * 64);
+  for (std::uint32_t i = 0; i < dem_x.size(); ++i)
+    grid.for_each_candidate(dem_x[i], [&](std::uint32_t a) {
+      const Vec3 m = box.min_image(dem_x[i] - sph_x[a]);
+      const double dx2 = m.x() * m.x();
+      if (dx2 >= rc2) return;
+      for (int iz = -kz; iz <= kz; ++iz) {
+        const double ez = m.z() + iz * box.lz;
+        for (int iy = -ky; iy <= ky; ++iy) {
+          const double ey = m.y() + iy * box.ly;
+          const double r2 = dx2 + ey * ey + ez * ez;
+          if (r2 < rc2) out.push_back({i, a, kernel_w(std::sqrt(r2), h)});
+        }
+      }
+    });
   return out;
 }
 

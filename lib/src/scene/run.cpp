@@ -12,9 +12,10 @@
 #include "mrf/error.hpp"
 #include "mrf/fluid/couette_sph.hpp"
 #include "mrf/forces/drag.hpp"
-#include "mrf/observe/block_average.hpp"
 #include "mrf/observe/stress.hpp"
 #include "mrf/scene/dem_model.hpp"
+#include "mrf/scene/run_coupled.hpp"
+#include "mrf/scene/run_series.hpp"
 
 namespace mrf {
 
@@ -67,39 +68,6 @@ void print_limits(const TimeStepChoice& t, const RunSummary& s) {
   std::fprintf(stderr, "  chosen: %s, dt = %.4g s (bound by '%s'), %ld steps; St = %.3g, Re_p = %.3g\n",
                to_string(t.scheme), t.dt, binding(t.limits).name.c_str(), s.steps, s.stokes_number,
                s.reynolds_number);
-}
-
-// Running sums of one time-series row.
-struct Row {
-  double tau_p = 0, vir_mag = 0, vir_con = 0, max_overlap = 0, e_dip = 0, e_hertz = 0;
-  int n = 0;
-  void add(const PairSums& p, const Box& box) {
-    tau_p += wall_shear_stress(p.wall_fz, box);
-    vir_mag += virial_shear_stress(p.virial_mag_xz, box);
-    vir_con += virial_shear_stress(p.virial_con_xz, box);
-    max_overlap = std::max(max_overlap, p.max_overlap);
-    e_dip += p.energy_dipole;
-    e_hertz += p.energy_hertz;
-    ++n;
-  }
-};
-
-struct Series {
-  std::vector<double> total, particles, virial, mag, con, diff;
-};
-
-Measurement measure(const std::vector<double>& v) {
-  const BlockAverage b = block_average(v);
-  return {b.mean, b.sem, b.drift_z};
-}
-
-void write_frame(std::ofstream& out, const ShearCell& cell, double radius, double time) {
-  out << cell.free.size() + cell.walls.size() << "\n";
-  out << "Lattice=\"" << cell.box.gap + 2 * radius << " 0 0 0 " << cell.box.ly << " 0 0 0 "
-      << cell.box.lz << "\" Origin=\"" << -0.5 * cell.box.gap - radius
-      << " 0 0\" Properties=species:S:1:pos:R:3:radius:R:1 Time=" << time << "\n";
-  for (const auto& x : cell.free.x) out << "Fe " << x.x() << " " << x.y() << " " << x.z() << " " << radius << "\n";
-  for (const auto& x : cell.walls.x) out << "W " << x.x() << " " << x.y() << " " << x.z() << " " << radius << "\n";
 }
 
 }  // namespace
@@ -182,9 +150,7 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
   const SceneConfig& c = scene.config;
   if (c.model != ModelId::dem_stokes) {
     if (c.volume_fraction == 0) return run_fluid_only(scene, opt);
-    throw InputError("scene.model", to_string(c.model), scene.locate("scene.model"),
-                     "the coupled DEM-SPH models with particles are not implemented yet (issue #5); "
-                     "with particles.volume_fraction = 0 this model runs the fluid alone");
+    return run_coupled_scene(scene, opt);
   }
   if (c.threads > 0) omp_set_num_threads(c.threads);
   const DemParams p = dem_params(c);
@@ -196,51 +162,33 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
   if (!opt.quiet) print_limits(ts, s);
 
   DemModel model(std::move(cell), p, ts.scheme, ts.dt);
-  const long every = c.every > 0 ? c.every : std::max(1L, s.steps / 2000);
-  const double rows_after_warmup = (1.0 - c.warmup_strain / c.strain) * static_cast<double>(s.steps / every);
-  if (rows_after_warmup < 32)
-    throw InputError("output.every", std::to_string(every), scene.locate("output.every"),
-                     "leaves only " + std::to_string(static_cast<long>(rows_after_warmup)) +
-                         " time-series rows after the warm-up; block averaging needs at least 32");
+  const long every = series_every(scene, s.steps);
   const long frame_every = c.frames > 0 ? std::max(1L, s.steps / c.frames) : 0;
   std::ofstream ts_out, frames_out;
   if (!opt.out_dir.empty()) {
     std::filesystem::create_directories(opt.out_dir);
     ts_out.open(opt.out_dir + "/timeseries.csv");
     ts_out.precision(10);
-    ts_out << "time_s,strain,stress_total_Pa,stress_particles_Pa,stress_fluid_Pa,"
-              "stress_virial_magnetic_Pa,stress_virial_contact_Pa,max_overlap_over_radius,"
-              "energy_dipole_J,energy_hertz_J\n";
+    write_series_header(ts_out);
     if (frame_every > 0) frames_out.open(opt.out_dir + "/frames.xyz");
   }
-  Series se;
-  Row row;
+  StressSeries se;
+  SeriesRow row;
   double max_overlap = 0;
   long pair_evals = 0;
   const auto t0 = std::chrono::steady_clock::now();
   auto last_report = t0;
   for (long n = 1; n <= s.steps; ++n) {
     model.step();
-    row.add(model.sums(), model.cell().box);
+    row.add(model.sums(), model.cell().box, s.stress_fluid);
     pair_evals += model.sums().pair_evaluations;
     if (frame_every > 0 && n % frame_every == 0 && frames_out) write_frame(frames_out, model.cell(), p.radius, model.time());
     if (n % every != 0 && n != s.steps) continue;
-    const double k = 1.0 / row.n, strain = model.time() * c.shear_rate;
-    const double tp = row.tau_p * k, vm = row.vir_mag * k, vc = row.vir_con * k;
+    const double strain = model.time() * c.shear_rate;
     max_overlap = std::max(max_overlap, row.max_overlap);
-    if (ts_out)
-      ts_out << model.time() << "," << strain << "," << tp + s.stress_fluid << "," << tp << ","
-             << s.stress_fluid << "," << vm << "," << vc << "," << row.max_overlap / p.radius << ","
-             << row.e_dip * k << "," << row.e_hertz * k << "\n";
-    if (strain - row.n * ts.dt * c.shear_rate >= c.warmup_strain) {  // whole row after warm-up
-      se.total.push_back(tp + s.stress_fluid);
-      se.particles.push_back(tp);
-      se.virial.push_back(vm + vc);
-      se.mag.push_back(vm);
-      se.con.push_back(vc);
-      se.diff.push_back(tp - vm - vc);
-    }
-    row = Row{};
+    if (ts_out) write_series_row(ts_out, model.time(), strain, row, p.radius);
+    if (strain - row.n * ts.dt * c.shear_rate >= c.warmup_strain) se.push(row);  // whole row after warm-up
+    row = SeriesRow{};
     const auto now = std::chrono::steady_clock::now();
     if (!opt.quiet && std::chrono::duration<double>(now - last_report).count() > 2.0) {
       last_report = now;
@@ -252,12 +200,7 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
   }
   s.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (!opt.quiet) std::fprintf(stderr, "\r  done: %ld steps in %.1f s%30s\n", s.steps, s.wall_seconds, "");
-  s.stress_total = measure(se.total);
-  s.stress_particles = measure(se.particles);
-  s.stress_virial = measure(se.virial);
-  s.stress_virial_magnetic = measure(se.mag);
-  s.stress_virial_contact = measure(se.con);
-  s.wall_minus_virial = measure(se.diff);
+  se.finish(s);
   s.max_overlap_over_radius = max_overlap / p.radius;
   s.neighbor_builds = model.lists().builds;
   s.particle_steps_per_second = static_cast<double>(s.n_particles * s.steps) / s.wall_seconds;

@@ -30,10 +30,10 @@ struct CouplingPair {
   double w;
 };
 
-// All DEM-SPH pairs closer than 2h (cell lists, minimum image in y and z).
-// Requires ly, lz >= 4h so that at most one periodic image interacts (the
-// neighbour search returns only the minimum image); throws
-// std::invalid_argument otherwise or if h <= 0.
+// All DEM-SPH pairs closer than 2h (cell lists, periodic in y and z). When
+// ly or lz < 4h a pair can interact through two periodic images; each image
+// is then its own entry (as in SphPairs), so scatter and gather stay
+// consistent in small boxes. Throws std::invalid_argument if h <= 0.
 std::vector<CouplingPair> coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x,
                                          const Box& box, double h);
 

@@ -1,0 +1,48 @@
+// Pieces of a run loop shared by the DEM and the coupled runs: time-series
+// rows (sums over the steps between two rows), the block-averaged stress
+// series of the steady part, the timeseries.csv format and particle frames.
+#pragma once
+#include <ostream>
+#include <vector>
+
+#include "mrf/scene/dem_forces.hpp"
+#include "mrf/scene/run.hpp"
+#include "mrf/scene/shear_cell.hpp"
+
+namespace mrf {
+
+// Running sums of one time-series row (stresses in Pa, overlap in m, J).
+struct SeriesRow {
+  double particles = 0, fluid = 0, vir_mag = 0, vir_con = 0, max_overlap = 0, e_dip = 0, e_hertz = 0;
+  int n = 0;
+  // One step: the particles' pair sums and the fluid's wall stress (Pa).
+  void add(const PairSums& p, const Box& box, double fluid_stress);
+};
+
+// Row means after the warm-up, block-averaged at the end (observe/block_average).
+class StressSeries {
+ public:
+  void push(const SeriesRow& row);
+  // Fills stress_total, stress_particles, stress_fluid (mean), stress_virial
+  // (particle pair virial; the fluid part is stress_fluid in every model),
+  // its magnetic and contact parts, and wall_minus_virial (particle wall
+  // stress - pair virial).
+  void finish(RunSummary& s) const;
+  std::size_t size() const { return total_.size(); }
+  Measurement fluid() const;
+
+ private:
+  std::vector<double> total_, particles_, fluid_, virial_, mag_, con_, diff_;
+};
+
+void write_series_header(std::ostream& out);
+void write_series_row(std::ostream& out, double time, double strain, const SeriesRow& row, double radius);
+
+// Extended-XYZ frame of free and wall spheres (OVITO, ParaView).
+void write_frame(std::ostream& out, const ShearCell& cell, double radius, double time);
+
+// Steps between rows (output.every or ~2000 rows) and the check that at
+// least 32 rows follow the warm-up; throws InputError on output.every.
+long series_every(const LoadedScene& scene, long steps);
+
+}  // namespace mrf

@@ -1,0 +1,236 @@
+#include "mrf/scene/coupled_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "mrf/coupling/drag_laws.hpp"
+#include "mrf/error.hpp"
+#include "mrf/fluid/fluid_observables.hpp"
+#include "mrf/fluid/viscosity.hpp"
+#include "mrf/fluid/wcsph.hpp"
+#include "mrf/integrate/stability.hpp"
+#include "mrf/integrate/steps.hpp"
+
+namespace mrf {
+
+namespace {
+
+Vec3 sum_of(const std::vector<Vec3>& f) {
+  Vec3 s = Vec3::Zero();
+  for (const Vec3& x : f) s += x;
+  return s;
+}
+
+}  // namespace
+
+FluidCell build_coupled_fluid(const SceneConfig& c, const ShearCell& cell) {
+  FluidParams fp;
+  fp.viscosity = c.viscosity;
+  fp.density = c.fluid_density;
+  fp.spacing = c.sph_spacing;
+  fp.sound_speed = c.sound_speed;
+  fp.shear_rate = c.shear_rate;
+  FluidCell f = build_fluid_cell(cell.box, fp);
+  const double phi = static_cast<double>(cell.free.size()) * sphere_volume(c.radius) / cell.box.volume();
+  f.mass *= 1.0 - phi;
+  for (std::size_t a = 0; a < f.fluid.size(); ++a) f.fluid.v[a] = Vec3(0.0, 0.0, c.shear_rate * f.fluid.x[a].x());
+  refresh(f);
+  return f;
+}
+
+double coupled_viscous_limit(const FluidCell& f, double eps_min) {
+  return 0.125 * f.h * f.h * eps_min * f.params.density / (f.params.viscosity * f.viscous_scale);
+}
+
+CoupledModel::CoupledModel(ShearCell cell, const DemParams& params, FluidCell fluid, CoupledDrag law,
+                           double dt_fluid, int substeps)
+    : cell_(std::move(cell)), p_(params), fluid_(std::move(fluid)), law_(law), dt_(dt_fluid), substeps_(substeps) {
+  if (!(dt_ > 0) || substeps_ < 1) throw InputError("numerics.dt", std::to_string(dt_), "", "coupled step must be > 0");
+  const std::size_t n = cell_.free.size();
+  cell_.free.v.resize(n, Vec3::Zero());
+  cell_.free.f.resize(n, Vec3::Zero());
+  const double two_r = 2.0 * p_.radius;
+  const double ff_range = p_.dipole_pref > 0 ? std::max(p_.dipole_cutoff, two_r) : two_r;
+  lists_ = make_pair_lists(ff_range, cell_.walls.size() > 0 ? two_r : 0.0, p_.skin);
+  overlap_limit_ = critical_overlap(p_, IntegratorId::verlet_exp, dt_dem());
+  parcel_.u.assign(n, Vec3::Zero());
+  parcel_.impulse.assign(n, Vec3::Zero());
+  update_coupling_pairs();
+  update_dem_forces();
+}
+
+Vec3 CoupledModel::momentum() const {
+  return p_.mass * sum_of(cell_.free.v) + fluid_.mass * sum_of(fluid_.fluid.v);
+}
+
+// Pairs, porosity and pressures for the current DEM and SPH positions.
+void CoupledModel::update_coupling_pairs() {
+  pairs_ = coupling_pairs(cell_.free.x, fluid_.fluid.x, cell_.box, fluid_.h);
+  PorosityField eps = porosity_at_fluid(fluid_.fluid.size(), sphere_volume(p_.radius), pairs_);
+  fluid_.fluid.eps = std::move(eps.eps);
+  sums_.eps_clamped = eps.clamped;
+  const auto [lo, hi] = std::minmax_element(fluid_.fluid.eps.begin(), fluid_.fluid.eps.end());
+  sums_.eps_min = lo == fluid_.fluid.eps.end() ? 1.0 : *lo;
+  sums_.eps_max = hi == fluid_.fluid.eps.end() ? 1.0 : *hi;
+  update_pressures(fluid_);
+}
+
+// Fluid fields at the particles (Shepard, REFERENCE §6), buoyancy, friction
+// coefficient and parcel inertia, frozen for the coming fluid step.
+// a_fluid: acceleration of every SPH particle from its own (non-coupling)
+// forces; its pressure + viscous part times the superficial density is
+// -grad p + div tau.
+void CoupledModel::prepare_coupling(const std::vector<Vec3>& a_fluid) {
+  const std::size_t n = cell_.free.size(), nf = fluid_.fluid.size();
+  const auto& rho = fluid_.fluid.rho;
+  shepard_ = shepard_interpolate(n, pairs_, fluid_.mass, rho, fluid_.fluid.v, fluid_.fluid.eps);
+  const Vec3 g_body(0.0, 0.0, fluid_.params.body_force);
+  // Omega_a = sum_j W_aj / s_j: how strongly the SPH particle a receives reactions.
+  std::vector<double> omega(nf, 0.0);
+  for (const CouplingPair& q : pairs_) omega[q.a] += q.w / shepard_.s[q.i];
+  std::vector<Vec3> acc(n, Vec3::Zero()), stress_div(n, Vec3::Zero());
+  std::vector<double> inv_m(n, 0.0);
+  for (const CouplingPair& q : pairs_) {
+    const double w = fluid_.mass * q.w / rho[q.a];  // Shepard weight (m/rho_a) W_ia
+    acc[q.i] += w * a_fluid[q.a];
+    stress_div[q.i] += (w * rho[q.a]) * (a_fluid[q.a] - g_body);
+    inv_m[q.i] += w * omega[q.a] / rho[q.a];
+  }
+  const double vp = sphere_volume(p_.radius);
+  const DiFeliceDrag dd{2.0 * p_.radius, fluid_.params.density, fluid_.params.viscosity};
+  const StokesCoupledDrag st{p_.radius, fluid_.params.viscosity};
+  u_at_ = shepard_.u;
+  eps_at_ = shepard_.eps;
+  buoyancy_.resize(n);
+  coupling_.gamma.resize(n);
+  coupling_.inv_mass.resize(n);
+  coupling_.g.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double s = shepard_.s[i];
+    // Collective inertia: the Shepard response of u_i to equal impulses of
+    // all particles is -J sum_a (m/rho_a^2) W_ia Omega_a / s_i = -J/M_i
+    // (exact for an isolated particle and for a uniform suspension).
+    coupling_.inv_mass[i] = inv_m[i] / s;
+    buoyancy_[i] = vp * stress_div[i] / s;
+    const double slip = (u_at_[i] - cell_.free.v[i]).norm();
+    coupling_.gamma[i] = law_ == CoupledDrag::stokes ? drag_coefficient(st, slip, eps_at_[i])
+                                                     : drag_coefficient(dd, slip, eps_at_[i]);
+    // The parcel feels its fluid forces and the reaction of the buoyancy.
+    coupling_.g[i] = acc[i] / s - coupling_.inv_mass[i] * buoyancy_[i];
+  }
+  parcel_.u = u_at_;
+  std::fill(parcel_.impulse.begin(), parcel_.impulse.end(), Vec3::Zero());
+}
+
+void CoupledModel::update_dem_forces() {
+  auto& f = cell_.free;
+  for (std::size_t i = 0; i < f.size(); ++i)
+    if (!f.x[i].allFinite() || !f.v[i].allFinite()) {
+      std::ostringstream s;
+      s << "non-finite " << (f.x[i].allFinite() ? "velocity" : "position") << " of particle " << i
+        << " at DEM sub-step " << dem_steps() << " (fluid step " << steps_ << ", t = " << time_ << " s)";
+      throw NumericalError(s.str());
+    }
+  wrap_all(f.x, cell_.box);
+  wrap_all(cell_.walls.x, cell_.box);
+  if (needs_rebuild(lists_, f, cell_.box)) build_pair_lists(lists_, f, cell_.walls, cell_.box);
+  const PairSums ps = compute_dem_forces(p_, cell_.box, f, cell_.walls, lists_, buffers_);
+  sums_.dem.wall_fz[0] += ps.wall_fz[0];
+  sums_.dem.wall_fz[1] += ps.wall_fz[1];
+  sums_.dem.virial_mag_xz += ps.virial_mag_xz;
+  sums_.dem.virial_con_xz += ps.virial_con_xz;
+  sums_.dem.max_overlap = std::max(sums_.dem.max_overlap, ps.max_overlap);
+  sums_.dem.energy_dipole = ps.energy_dipole;
+  sums_.dem.energy_hertz = ps.energy_hertz;
+  sums_.dem.pair_evaluations += ps.pair_evaluations;
+  check_dem();
+}
+
+void CoupledModel::check_dem() const {
+  const auto& f = cell_.free;
+  for (std::size_t i = 0; i < f.size(); ++i)
+    if (!f.f[i].allFinite()) {
+      std::ostringstream s;
+      s << "non-finite force on particle " << i << " at DEM sub-step " << dem_steps() << " (t = " << time_ << " s)";
+      throw NumericalError(s.str());
+    }
+  if (sums_.dem.max_overlap > overlap_limit_) {
+    std::ostringstream s;
+    s << "contact stability limit exceeded at fluid step " << steps_ << " (t = " << time_
+      << " s): overlap/R = " << sums_.dem.max_overlap / p_.radius << " > " << overlap_limit_ / p_.radius
+      << ", the largest overlap the DEM sub-step " << dt_dem() << " s keeps stable; lower numerics.dt_safety";
+    throw NumericalError(s.str());
+  }
+}
+
+void CoupledModel::dem_substep() {
+  auto& f = cell_.free;
+  const double h = dt_dem();
+  for (std::size_t i = 0; i < f.size(); ++i) f_old_[i] = f.f[i] + buoyancy_[i] + body_force_;
+  const Vec3 dem_old = sum_of(f.f);
+  parcel_advance(f.x, f.v, f_old_, coupling_, parcel_, p_.mass, h);
+  move_walls(cell_.walls, p_.shear_rate, h);
+  lists_.wall_travel += std::abs(p_.shear_rate) * 0.5 * cell_.box.gap * h;
+  update_dem_forces();
+  for (std::size_t i = 0; i < f.size(); ++i) f_new_[i] = f.f[i] + buoyancy_[i] + body_force_;
+  parcel_correct(f.v, f_old_, f_new_, coupling_, parcel_, p_.mass, h);
+  // Pair forces cancel: what is left of sum_i F_i is the walls' push.
+  external_impulse_ += 0.5 * h * (dem_old + sum_of(f.f)) + (h * static_cast<double>(f.size())) * body_force_;
+}
+
+void CoupledModel::step() {
+  const std::size_t n = cell_.free.size(), nf = fluid_.fluid.size();
+  // Fluid forces of the current state (explicit SPH, REFERENCE §5).
+  std::vector<Vec3> a = external_acceleration(fluid_);
+  add_pressure_acceleration(fluid_, a);
+  add_viscous_acceleration(fluid_, a);
+  sums_.fluid_stress = wall_shear_stress(fluid_).tau;
+  prepare_coupling(a);
+
+  sums_.dem = PairSums{};
+  f_old_.resize(n);
+  f_new_.resize(n);
+  for (int k = 0; k < substeps_; ++k) dem_substep();
+  const double inv = 1.0 / substeps_;
+  sums_.dem.wall_fz[0] *= inv;
+  sums_.dem.wall_fz[1] *= inv;
+  sums_.dem.virial_mag_xz *= inv;
+  sums_.dem.virial_con_xz *= inv;
+
+  // Exchange: the fluid receives minus the drag impulse and minus the
+  // buoyancy impulse, scattered with the Shepard weights (exact, §6).
+  std::vector<Vec3> exchange(n), kick(nf, Vec3::Zero());
+  for (std::size_t i = 0; i < n; ++i) exchange[i] = parcel_.impulse[i] + dt_ * buoyancy_[i];
+  add_back_coupling(pairs_, exchange, shepard_.s, fluid_.fluid.rho, kick);
+  Vec3 fluid_force = Vec3::Zero();
+  for (std::size_t b = 0; b < nf; ++b) {
+    fluid_.fluid.v[b] += dt_ * a[b] + kick[b];
+    fluid_force += a[b];
+  }
+  external_impulse_ += (dt_ * fluid_.mass) * fluid_force;  // SPH pair terms cancel: walls + body force
+  for (std::size_t b = 0; b < nf; ++b) {
+    fluid_.fluid.x[b] += dt_ * fluid_.fluid.v[b];
+    fluid_.box.wrap(fluid_.fluid.x[b]);
+    const Vec3& x = fluid_.fluid.x[b];
+    if (!x.allFinite() || !fluid_.fluid.v[b].allFinite() || std::abs(x.x()) >= 0.5 * fluid_.box.gap) {
+      std::ostringstream s;
+      s << "SPH particle " << b << (x.allFinite() ? " crossed a wall plane" : " became non-finite")
+        << " at fluid step " << steps_ << " (t = " << time_ << " s): x = (" << x.transpose() << ") m, v = ("
+        << fluid_.fluid.v[b].transpose() << ") m/s";
+      throw NumericalError(s.str());
+    }
+  }
+  for (std::size_t w = 0; w < fluid_.wall.size(); ++w) {
+    fluid_.wall.x[w] += dt_ * fluid_.wall.v[w];
+    fluid_.box.wrap(fluid_.wall.x[w]);
+  }
+  time_ += dt_;
+  fluid_.time = time_;
+  ++steps_;
+  fluid_.steps = steps_;
+  refresh(fluid_);
+  update_coupling_pairs();
+}
+
+}  // namespace mrf
