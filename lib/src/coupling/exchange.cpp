@@ -85,6 +85,15 @@ ShepardField shepard_interpolate(std::size_t n_dem, const std::vector<CouplingPa
   return out;
 }
 
+std::vector<Vec3> generalised_buoyancy(std::size_t n_dem, const std::vector<CouplingPair>& pairs, double mass,
+                                       const std::vector<double>& s, const std::vector<Vec3>& a_fluid,
+                                       double particle_volume) {
+  std::vector<Vec3> f(n_dem, Vec3::Zero());
+  for (const CouplingPair& p : pairs) f[p.i] += (mass * p.w) * a_fluid[p.a];  // (m/rho) W x rho a
+  for (std::size_t i = 0; i < n_dem; ++i) f[i] *= particle_volume / s[i];
+  return f;
+}
+
 void add_back_coupling(const std::vector<CouplingPair>& pairs, const std::vector<Vec3>& force,
                        const std::vector<double>& s, const std::vector<double>& rho, std::vector<Vec3>& a_out) {
   for (const CouplingPair& p : pairs) a_out[p.a] -= (p.w / (rho[p.a] * s[p.i])) * force[p.i];

@@ -88,10 +88,10 @@ void refresh(FluidCell& c) {
 
 void update_pressures(FluidCell& c) {
   c.fluid.p.resize(c.fluid.size());
-  const bool porous = !c.fluid.eps.empty();
+  const bool porous = !c.fluid.eps.empty(), labelled = !c.fluid.rest_density.empty();
   for (std::size_t a = 0; a < c.fluid.size(); ++a) {
     const double rho = porous ? c.fluid.rho[a] / c.fluid.eps[a] : c.fluid.rho[a];
-    c.fluid.p[a] = eos_pressure(rho, c.params.density, c.c0);
+    c.fluid.p[a] = eos_pressure(rho, labelled ? c.fluid.rest_density[a] : c.params.density, c.c0);
   }
   wall_pressure(c);
 }

@@ -56,7 +56,16 @@ CoupledModel::CoupledModel(ShearCell cell, const DemParams& params, FluidCell fl
   overlap_limit_ = critical_overlap(p_, IntegratorId::verlet_exp, dt_dem());
   parcel_.u.assign(n, Vec3::Zero());
   parcel_.impulse.assign(n, Vec3::Zero());
+  // The rest state: each SPH particle's intrinsic density at the start is its
+  // EOS reference, so the start carries no pressure from the porosity field
+  // (near the walls eps is higher than the mean 1 - phi the mass is scaled
+  // by); later changes of eps displace the fluid through the pressure.
+  fluid_.fluid.rest_density.clear();
   update_coupling_pairs();
+  fluid_.fluid.rest_density.resize(fluid_.fluid.size());
+  for (std::size_t a = 0; a < fluid_.fluid.size(); ++a)
+    fluid_.fluid.rest_density[a] = fluid_.fluid.rho[a] / fluid_.fluid.eps[a];
+  update_pressures(fluid_);
   update_dem_forces();
 }
 
@@ -89,20 +98,19 @@ void CoupledModel::prepare_coupling(const std::vector<Vec3>& a_fluid) {
   // Omega_a = sum_j W_aj / s_j: how strongly the SPH particle a receives reactions.
   std::vector<double> omega(nf, 0.0);
   for (const CouplingPair& q : pairs_) omega[q.a] += q.w / shepard_.s[q.i];
-  std::vector<Vec3> acc(n, Vec3::Zero()), stress_div(n, Vec3::Zero());
+  std::vector<Vec3> acc(n, Vec3::Zero()), a_pv(nf);
   std::vector<double> inv_m(n, 0.0);
   for (const CouplingPair& q : pairs_) {
     const double w = fluid_.mass * q.w / rho[q.a];  // Shepard weight (m/rho_a) W_ia
     acc[q.i] += w * a_fluid[q.a];
-    stress_div[q.i] += (w * rho[q.a]) * (a_fluid[q.a] - g_body);
     inv_m[q.i] += w * omega[q.a] / rho[q.a];
   }
-  const double vp = sphere_volume(p_.radius);
+  for (std::size_t b = 0; b < nf; ++b) a_pv[b] = a_fluid[b] - g_body - fluid_.fluid.a_ext[b];
+  buoyancy_ = generalised_buoyancy(n, pairs_, fluid_.mass, shepard_.s, a_pv, sphere_volume(p_.radius));
   const DiFeliceDrag dd{2.0 * p_.radius, fluid_.params.density, fluid_.params.viscosity};
   const StokesCoupledDrag st{p_.radius, fluid_.params.viscosity};
   u_at_ = shepard_.u;
   eps_at_ = shepard_.eps;
-  buoyancy_.resize(n);
   coupling_.gamma.resize(n);
   coupling_.inv_mass.resize(n);
   coupling_.g.resize(n);
@@ -112,7 +120,6 @@ void CoupledModel::prepare_coupling(const std::vector<Vec3>& a_fluid) {
     // all particles is -J sum_a (m/rho_a^2) W_ia Omega_a / s_i = -J/M_i
     // (exact for an isolated particle and for a uniform suspension).
     coupling_.inv_mass[i] = inv_m[i] / s;
-    buoyancy_[i] = vp * stress_div[i] / s;
     const double slip = (u_at_[i] - cell_.free.v[i]).norm();
     coupling_.gamma[i] = law_ == CoupledDrag::stokes ? drag_coefficient(st, slip, eps_at_[i])
                                                      : drag_coefficient(dd, slip, eps_at_[i]);

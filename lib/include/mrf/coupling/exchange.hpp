@@ -66,6 +66,18 @@ ShepardField shepard_interpolate(std::size_t n_dem, const std::vector<CouplingPa
                                  const std::vector<double>& rho, const std::vector<Vec3>& v,
                                  const std::vector<double>& eps);
 
+// Generalised buoyancy of the averaged equations (model A, REFERENCE §6):
+//   F_i = V_p (-grad p + div tau)_i = V_p sum_a (m/rho_a) W_ia (rho_a a_a) / s_i,
+// with a_a the SPH pressure + viscous acceleration of fluid particle a (m/s^2,
+// no body force, no coupling). The SPH sums divided by rho_a give
+// (-grad p + div tau)/rho_a, so rho_a a_a is the mixture's force density
+// whatever rho is (superficial or not): the buoyancy is V_p grad p, not
+// V_p grad p / eps (Robinson's rho_f form with superficial rho) and not 0
+// (model B). particle_volume V_p in m^3; returns N.
+std::vector<Vec3> generalised_buoyancy(std::size_t n_dem, const std::vector<CouplingPair>& pairs, double mass,
+                                       const std::vector<double>& s, const std::vector<Vec3>& a_fluid,
+                                       double particle_volume);
+
 // Back-reaction of the fluid-to-particle forces F_i (N) on the SPH particles:
 //   a_out[a] += -(1/rho_a) sum_i F_i W_ia / s_i   (m/s^2),
 // accumulated (e.g. into FluidParticles::a_ext). With s from

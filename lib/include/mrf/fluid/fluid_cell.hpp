@@ -29,6 +29,10 @@ struct FluidParticles {
   // (REFERENCE §6): the EOS takes the intrinsic density rho/eps. Empty for a
   // pure fluid (eps = 1), so fluid-only runs are unchanged.
   std::vector<double> eps;
+  // EOS reference of each particle's intrinsic density (kg/m^3), carried
+  // with the particle; empty = params.density. The coupled models set it to
+  // the intrinsic density of the start, which is then free of pressure.
+  std::vector<double> rest_density;
   std::size_t size() const { return x.size(); }
 };
 
