@@ -178,5 +178,19 @@ TEST(CoupledModel, SmallSceneRunsAtExtremeMasonNumbers) {
     }
 }
 
+// The base scene of model 1 runs under all three models by --set
+// scene.model: dem_stokes ignores [fluid] sph_spacing and builds no fluid.
+TEST(CoupledModel, BaseSceneRunsUnderAllThreeModels) {
+  for (const char* model : {"dem_stokes", "demsph_stokes", "demsph_dd"}) {
+    const LoadedScene scene = load_scene(MRF_SOURCE_DIR "/experiments/scenes/small_dem_stokes.toml",
+                                         {std::string("scene.model=\"") + model + "\"", "drive.strain=0.04",
+                                          "drive.warmup_strain=0.0", "output.every=1"});
+    const RunSummary s = run_scene(scene, {"", true});
+    EXPECT_EQ(s.model, model);
+    EXPECT_EQ(s.n_fluid, std::string(model) == "dem_stokes" ? 0 : 160) << model;
+    EXPECT_EQ(s.n_particles, 375) << model;
+  }
+}
+
 }  // namespace
 }  // namespace mrf
