@@ -180,7 +180,7 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
   auto last_report = t0;
   for (long n = 1; n <= s.steps; ++n) {
     model.step();
-    row.add(model.sums(), model.cell().box, s.stress_fluid);
+    row.add(model.sums(), model.cell().box, s.stress_fluid, s.stress_fluid);
     pair_evals += model.sums().pair_evaluations;
     if (frame_every > 0 && n % frame_every == 0 && frames_out) write_frame(frames_out, model.cell(), p.radius, model.time());
     if (n % every != 0 && n != s.steps) continue;

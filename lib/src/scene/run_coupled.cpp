@@ -151,7 +151,7 @@ RunSummary run_coupled_scene(const LoadedScene& scene, const RunOptions& opt) {
   for (long n = 1; n <= fluid_steps; ++n) {
     model.step();
     const CoupledStepSums& cs = model.sums();
-    row.add(cs.dem, model.cell().box, cs.fluid_stress);
+    row.add(cs.dem, model.cell().box, cs.fluid_stress, cs.fluid_virial + cs.exchange_virial);
     pair_evals += cs.dem.pair_evaluations;
     eps_min = std::min(eps_min, cs.eps_min);
     eps_max = std::max(eps_max, cs.eps_max);

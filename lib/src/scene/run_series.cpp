@@ -18,7 +18,8 @@ Measurement measure(const std::vector<double>& v) {
 
 }  // namespace
 
-void SeriesRow::add(const PairSums& p, const Box& box, double fluid_stress) {
+void SeriesRow::add(const PairSums& p, const Box& box, double fluid_stress, double fluid_virial) {
+  vir_fluid += fluid_virial;
   particles += wall_shear_stress(p.wall_fz, box);
   fluid += fluid_stress;
   vir_mag += virial_shear_stress(p.virial_mag_xz, box);
@@ -39,6 +40,8 @@ void StressSeries::push(const SeriesRow& r) {
   mag_.push_back(vm);
   con_.push_back(vc);
   diff_.push_back(tp - vm - vc);
+  vir_fluid_.push_back(r.vir_fluid * k);
+  vir_total_.push_back(vm + vc + r.vir_fluid * k);
 }
 
 Measurement StressSeries::fluid() const { return measure(fluid_); }
@@ -51,6 +54,10 @@ void StressSeries::finish(RunSummary& s) const {
   s.stress_virial_magnetic = measure(mag_);
   s.stress_virial_contact = measure(con_);
   s.wall_minus_virial = measure(diff_);
+  const Measurement vt = measure(vir_total_);
+  s.extra["stress_virial_total"] = vt.mean;
+  s.extra["stress_virial_total_err"] = vt.err;
+  s.extra["stress_virial_fluid"] = measure(vir_fluid_).mean;
 }
 
 void write_series_header(std::ostream& out) {

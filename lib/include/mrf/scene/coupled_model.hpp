@@ -39,6 +39,12 @@ enum class CoupledDrag { stokes, di_felice };
 struct CoupledStepSums {
   PairSums dem;                          // wall_fz and virials averaged over sub-steps; max_overlap the max
   double fluid_stress = 0;               // SPH wall shear stress at the start of the step (Pa)
+  // Virial shear stress -(1/V) sum r_x F_z of the fluid pairs (SPH pressure
+  // + Morris viscous, fluid-wall pairs included) and of the particle-fluid
+  // exchange (each particle's force split over its SPH neighbours with the
+  // scatter weights), Pa: with the particle pair virial, the volume side of
+  // the wall stress (REFERENCE §7).
+  double fluid_virial = 0, exchange_virial = 0;
   double eps_min = 1, eps_max = 1;       // porosity range at the SPH particles
   std::size_t eps_clamped = 0;           // SPH particles at the porosity floor
 };

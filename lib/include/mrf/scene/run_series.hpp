@@ -13,10 +13,12 @@ namespace mrf {
 
 // Running sums of one time-series row (stresses in Pa, overlap in m, J).
 struct SeriesRow {
-  double particles = 0, fluid = 0, vir_mag = 0, vir_con = 0, max_overlap = 0, e_dip = 0, e_hertz = 0;
+  double particles = 0, fluid = 0, vir_mag = 0, vir_con = 0, vir_fluid = 0, max_overlap = 0, e_dip = 0,
+         e_hertz = 0;
   int n = 0;
-  // One step: the particles' pair sums and the fluid's wall stress (Pa).
-  void add(const PairSums& p, const Box& box, double fluid_stress);
+  // One step: the particles' pair sums, the fluid's wall stress and the
+  // fluid's virial stress (Pa; eta gdot for the imposed profile of model 1).
+  void add(const PairSums& p, const Box& box, double fluid_stress, double fluid_virial);
 };
 
 // Row means after the warm-up, block-averaged at the end (observe/block_average).
@@ -26,13 +28,15 @@ class StressSeries {
   // Fills stress_total, stress_particles, stress_fluid (mean), stress_virial
   // (particle pair virial; the fluid part is stress_fluid in every model),
   // its magnetic and contact parts, and wall_minus_virial (particle wall
-  // stress - pair virial).
+  // stress - pair virial). The volume-side total, pair virial + fluid
+  // virial, goes to extra["stress_virial_total"] (+ "_err") beside
+  // extra["stress_virial_fluid"]: it must match stress_total in steady state.
   void finish(RunSummary& s) const;
   std::size_t size() const { return total_.size(); }
   Measurement fluid() const;
 
  private:
-  std::vector<double> total_, particles_, fluid_, virial_, mag_, con_, diff_;
+  std::vector<double> total_, particles_, fluid_, virial_, mag_, con_, diff_, vir_fluid_, vir_total_;
 };
 
 void write_series_header(std::ostream& out);
