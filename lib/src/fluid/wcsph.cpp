@@ -38,6 +38,12 @@ void wall_pressure(FluidCell& c) {
   }
   for (std::size_t b = 0; b < nw; ++b) {
     c.wall.p[b] = adami_wall_pressure(sum_pw[b], sum_grw[b], sum_w[b]);
+    // In the averaged equations the porosity field moves faster than the
+    // fluid particles rearrange, and the fluid next to a wall can go into
+    // tension; a wall extrapolating that tension pulls SPH particles through
+    // it. The wall does not adhere: its pressure is kept >= 0, so fluid in
+    // tension retracts toward the bulk instead.
+    if (porous) c.wall.p[b] = std::max(c.wall.p[b], 0.0);
     c.wall.rho[b] = eos_density(c.wall.p[b], c.params.density, c.c0);
     if (porous && sum_w[b] > 0.0) c.wall.rho[b] *= sum_ew[b] / sum_w[b];
   }

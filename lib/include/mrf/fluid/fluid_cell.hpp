@@ -90,7 +90,8 @@ void refresh(FluidCell& cell);
 // Pressures and wall densities from the current densities and porosities,
 // without a new pair search (refresh() ends with it). With porosity the wall
 // particles take the Shepard mean eps_w of their fluid neighbours and the
-// superficial density eps_w x eos_density(p_w), like the fluid they mirror.
+// superficial density eps_w x eos_density(p_w), like the fluid they mirror,
+// and a wall pressure clipped at 0 (no adhesion, see wcsph.cpp).
 void update_pressures(FluidCell& cell);
 
 // Neighbour pairs of the current positions (cell lists, periodic images).
