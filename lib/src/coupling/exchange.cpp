@@ -11,8 +11,8 @@
 
 namespace mrf {
 
-std::vector<CouplingPair> coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x,
-                                         const Box& box, double h) {
+void coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x, const Box& box, double h,
+                    std::vector<CouplingPair>& out) {
   if (!(h > 0.0)) throw std::invalid_argument("coupling_pairs: smoothing length h must be > 0");
   const double rc = k_kernel_support * h, rc2 = rc * rc;
   // Every periodic image closer than rc is its own entry: along y (z) a
@@ -29,22 +29,31 @@ std::vector<CouplingPair> coupling_pairs(const std::vector<Vec3>& dem_x, const s
   }
   CellGrid grid(box, x_lo - rc, x_hi + rc, rc);
   grid.bin(sph_x);
-  std::vector<CouplingPair> out;
-  out.reserve(dem_x.size() * 64);
-  for (std::uint32_t i = 0; i < dem_x.size(); ++i)
-    grid.for_each_candidate(dem_x[i], [&](std::uint32_t a) {
-      const Vec3 m = box.min_image(dem_x[i] - sph_x[a]);
-      const double dx2 = m.x() * m.x();
-      if (dx2 >= rc2) return;
+  const MinImageYZ mi(box);
+  out.clear();
+  for (std::uint32_t i = 0; i < dem_x.size(); ++i) {
+    const Vec3 xi = dem_x[i];
+    grid.for_each_candidate(xi, [&](std::uint32_t a) {
+      const Vec3& xa = sph_x[a];
+      const double dx = xi.x() - xa.x(), dx2 = dx * dx;
+      if (dx2 >= rc2) return;  // x is not periodic: cheap rejection first
+      const double dy = mi.wrap_y(xi.y() - xa.y()), dz = mi.wrap_z(xi.z() - xa.z());
       for (int iz = -kz; iz <= kz; ++iz) {
-        const double ez = m.z() + iz * box.lz;
+        const double ez = dz + iz * box.lz, rxz = dx2 + ez * ez;
+        if (rxz >= rc2) continue;
         for (int iy = -ky; iy <= ky; ++iy) {
-          const double ey = m.y() + iy * box.ly;
-          const double r2 = dx2 + ey * ey + ez * ez;
+          const double ey = dy + iy * box.ly, r2 = rxz + ey * ey;
           if (r2 < rc2) out.push_back({i, a, kernel_w(std::sqrt(r2), h)});
         }
       }
     });
+  }
+}
+
+std::vector<CouplingPair> coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x,
+                                         const Box& box, double h) {
+  std::vector<CouplingPair> out;
+  coupling_pairs(dem_x, sph_x, box, h, out);
   return out;
 }
 

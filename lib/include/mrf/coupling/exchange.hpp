@@ -36,6 +36,10 @@ struct CouplingPair {
 // consistent in small boxes. Throws std::invalid_argument if h <= 0.
 std::vector<CouplingPair> coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x,
                                          const Box& box, double h);
+// Same, into `out` (cleared; its capacity is reused). Pairs come sorted by
+// DEM index i.
+void coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x, const Box& box, double h,
+                    std::vector<CouplingPair>& out);
 
 // Default porosity floor: eps below it (overlapping kernels of a dense packing)
 // would make the drag and eps-weighted densities blow up; 0.2 is well below

@@ -100,7 +100,8 @@ class CoupledModel {
   int substeps_;
   DemPairLists lists_;
   ForceBuffers buffers_;
-  std::vector<CouplingPair> pairs_;
+  std::vector<CouplingPair> pairs_, solid_pairs_;  // real particles; with wall mirror images
+  std::vector<Vec3> solid_;
   ShepardField shepard_;
   std::vector<Vec3> u_at_, buoyancy_, f_old_, f_new_;
   std::vector<double> eps_at_;
