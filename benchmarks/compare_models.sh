@@ -9,13 +9,14 @@
 # seed and drive are identical. STRAIN / WARMUP (defaults 6 / 2) set the run
 # length. Prints stress parts with block-average errors and the wall time per
 # strain unit, and the cost ratio coupled / DEM, into
-# reports/performance/compare_models.md. One OpenMP thread per run; runs go
+# reports/performance/compare_models_<scene>.md. For the paper scene:
+#   STRAIN=1 WARMUP=0 benchmarks/compare_models.sh experiments/scenes/paper_dem_stokes.toml 1e-2 One OpenMP thread per run; runs go
 # one after the other so they do not compete for the 2 cores.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD=${BUILD:-build}
 MRF=$BUILD/mrf
-SCENE=${1:-experiments/scenes/small_demsph_stokes.toml}
+SCENE=${1:-experiments/scenes/small_dem_stokes.toml}
 shift || true
 MASONS=${*:-1e-2 1e-1}
 STRAIN=${STRAIN:-6}
@@ -27,13 +28,14 @@ mkdir -p "$OUT" "$TMP"
 rows=()
 for mn in $MASONS; do
   for model in dem_stokes demsph_stokes demsph_dd; do
-    dir=$TMP/$model-$mn
+    dir=$TMP/$(basename "$SCENE" .toml)-$model-$mn
     OMP_NUM_THREADS=1 "$MRF" run "$SCENE" --quiet --set scene.model=\"$model\" --set drive.mason=$mn \
       --set drive.strain=$STRAIN --set drive.warmup_strain=$WARMUP --out "$dir" >/dev/null
     rows+=("$dir/summary.json")
   done
 done
-"$PY" - "${rows[@]}" <<'PYEOF' | tee "$OUT/compare_models.md"
+name=$(basename "$SCENE" .toml)
+"$PY" - "${rows[@]}" <<'PYEOF' | tee "$OUT/compare_models_$name.md"
 import json, sys
 runs = [json.load(open(f)) for f in sys.argv[1:]]
 print("| model | Mn | stress_total (Pa) | particles (Pa) | fluid (Pa) | virial (Pa) | dt (s) | s/strain | cost / dem_stokes |")
