@@ -40,7 +40,10 @@ double fluid_pair_virial_xz(const FluidCell& c) {
     const Vec3 a = pressure_pair_acceleration(c.mass, f.p[pr.a], f.rho[pr.a], c.wall.p[pr.b], c.wall.rho[pr.b],
                                               pr.r_ab, pr.r, c.h) +
                    wall_viscous_acceleration(c, pr);
-    sum += pr.r_ab.x() * c.mass * a.z();
+    // Only the part of the bond inside the volume counts (Irving-Kirkwood):
+    // from the fluid particle to the wall plane, not to the wall particle
+    // up to 2h behind it.
+    sum += (c.fluid.x[pr.a].x() - c.wall.side[pr.b] * 0.5 * c.box.gap) * c.mass * a.z();
   }
   return sum;
 }
