@@ -38,8 +38,8 @@ name=$(basename "$SCENE" .toml)
 "$PY" - "${rows[@]}" <<'PYEOF' | tee "$OUT/compare_models_$name.md"
 import json, sys
 runs = [json.load(open(f)) for f in sys.argv[1:]]
-print("| model | Mn | stress_total (Pa) | particles (Pa) | fluid (Pa) | virial (Pa) | dt (s) | s/strain | cost / dem_stokes |")
-print("|---|---|---|---|---|---|---|---|---|")
+print("| model | Mn | stress_total (Pa) | particles (Pa) | fluid (Pa) | pair virial (Pa) | virial total (Pa) | dt (s) | s/strain | cost / dem_stokes |")
+print("|---|---|---|---|---|---|---|---|---|---|")
 base = {}
 for r in runs:
     sps = r["wall_seconds"] / r["strain"]
@@ -47,5 +47,6 @@ for r in runs:
     ratio = sps / base[r["mason"]]
     print(f"| {r['model']} | {r['mason']:g} | {r['stress_total']:.0f} +- {r['stress_total_err']:.0f} | "
           f"{r['stress_particles']:.0f} | {r['stress_fluid']:.0f} | {r['stress_virial']:.0f} +- {r['stress_virial_err']:.0f} | "
+          f"{r['stress_virial_total']:.0f} +- {r['stress_virial_total_err']:.0f} | "
           f"{r['dt']:.3g} | {sps:.2f} | {ratio:.2f} |")
 PYEOF

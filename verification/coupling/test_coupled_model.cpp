@@ -13,6 +13,7 @@
 
 #include "mrf/coupling/drag_laws.hpp"
 #include "mrf/coupling/exchange.hpp"
+#include "mrf/error.hpp"
 #include "mrf/fluid/fluid_observables.hpp"
 #include "mrf/fluid/wcsph.hpp"
 #include "mrf/io/toml_scene.hpp"
@@ -176,6 +177,24 @@ TEST(CoupledModel, SmallSceneRunsAtExtremeMasonNumbers) {
       EXPECT_TRUE(std::isfinite(s.stress_total.mean)) << model << " Mn " << mn;
       EXPECT_LT(s.extra.at("momentum_drift_relative"), 1e-12);
     }
+}
+
+// A non-finite particle state stops the run with a NumericalError naming the
+// particle and the step.
+TEST(CoupledModel, NonFiniteStateIsReportedWithParticleAndStep) {
+  const LoadedScene scene = load_scene(kSmall);
+  const DemParams p = dem_params(scene.config);
+  ShearCell cell = build_shear_cell(scene.config);
+  FluidCell fluid = build_coupled_fluid(scene.config, cell);
+  cell.free.v[17] = Vec3(0.0, std::nan(""), 0.0);
+  try {
+    CoupledModel m(std::move(cell), p, std::move(fluid), CoupledDrag::stokes, 3e-8, 12);
+    FAIL() << "expected NumericalError";
+  } catch (const NumericalError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("particle 17"), std::string::npos) << what;
+    EXPECT_NE(what.find("sub-step 0"), std::string::npos) << what;
+  }
 }
 
 // The base scene of model 1 runs under all three models by --set
