@@ -193,6 +193,7 @@ RunSummary run_coupled_scene(const LoadedScene& scene, const RunOptions& opt) {
   s.extra["momentum_drift_N_s"] = drift.norm();
   s.extra["momentum_drift_relative"] = momentum_scale > 0 ? drift.norm() / momentum_scale : 0.0;
   s.extra["seconds_per_strain"] = s.wall_seconds / c.strain;
+  s.extra["sph_wall_reflections"] = static_cast<double>(model.sums().wall_reflections);
   if (!opt.out_dir.empty()) std::ofstream(opt.out_dir + "/summary.json") << summary_json(s) << "\n";
   return s;
 }

@@ -47,6 +47,7 @@ struct CoupledStepSums {
   double fluid_virial = 0, exchange_virial = 0;
   double eps_min = 1, eps_max = 1;       // porosity range at the SPH particles
   std::size_t eps_clamped = 0;           // SPH particles at the porosity floor
+  long wall_reflections = 0;             // SPH particles reflected at a wall plane since the start
 };
 
 class CoupledModel {
