@@ -31,14 +31,16 @@ TEST(RunFluidOnly, CouetteSceneWritesSummaryWithEtaGdot) {
   EXPECT_TRUE(std::filesystem::exists(out + "/timeseries.csv"));
 }
 
-TEST(RunFluidOnly, CoupledModelWithParticlesIsRefusedClearly) {
-  const LoadedScene scene =
-      load_scene(MRF_SOURCE_DIR "/experiments/scenes/couette_sph.toml", {"particles.volume_fraction=0.1"});
+// With particles the coupled model runs (verification/coupling/); an SPH
+// spacing that does not tile the box is refused naming key and file line.
+TEST(RunFluidOnly, CoupledSceneWithBadSphSpacingNamesKeyAndLine) {
+  const LoadedScene scene = load_scene(MRF_SOURCE_DIR "/experiments/scenes/couette_sph.toml",
+                                       {"particles.volume_fraction=0.1", "box.ly=45e-6"});
   try {
     run_scene(scene, {"", true});
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("scene.model"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("fluid.sph_spacing"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("couette_sph.toml:"), std::string::npos) << e.what();
   }
 }

@@ -11,19 +11,49 @@
 
 namespace mrf {
 
+void coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x, const Box& box, double h,
+                    std::vector<CouplingPair>& out) {
+  if (!(h > 0.0)) throw std::invalid_argument("coupling_pairs: smoothing length h must be > 0");
+  const double rc = k_kernel_support * h, rc2 = rc * rc;
+  // Every periodic image closer than rc is its own entry: along y (z) a
+  // second image can interact only when ly (lz) < 2 rc = 4h.
+  const int ky = box.ly < 2.0 * rc ? 1 : 0, kz = box.lz < 2.0 * rc ? 1 : 0;
+  double x_lo = 0.0, x_hi = 0.0;
+  for (const Vec3& p : sph_x) {
+    x_lo = std::min(x_lo, p.x());
+    x_hi = std::max(x_hi, p.x());
+  }
+  for (const Vec3& p : dem_x) {
+    x_lo = std::min(x_lo, p.x());
+    x_hi = std::max(x_hi, p.x());
+  }
+  CellGrid grid(box, x_lo - rc, x_hi + rc, rc);
+  grid.bin(sph_x);
+  const MinImageYZ mi(box);
+  out.clear();
+  for (std::uint32_t i = 0; i < dem_x.size(); ++i) {
+    const Vec3 xi = dem_x[i];
+    grid.for_each_candidate(xi, [&](std::uint32_t a) {
+      const Vec3& xa = sph_x[a];
+      const double dx = xi.x() - xa.x(), dx2 = dx * dx;
+      if (dx2 >= rc2) return;  // x is not periodic: cheap rejection first
+      const double dy = mi.wrap_y(xi.y() - xa.y()), dz = mi.wrap_z(xi.z() - xa.z());
+      for (int iz = -kz; iz <= kz; ++iz) {
+        const double ez = dz + iz * box.lz, rxz = dx2 + ez * ez;
+        if (rxz >= rc2) continue;
+        for (int iy = -ky; iy <= ky; ++iy) {
+          const double ey = dy + iy * box.ly, r2 = rxz + ey * ey;
+          if (r2 < rc2) out.push_back({i, a, kernel_w(std::sqrt(r2), h)});
+        }
+      }
+    });
+  }
+}
+
 std::vector<CouplingPair> coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x,
                                          const Box& box, double h) {
-  if (!(h > 0.0)) throw std::invalid_argument("coupling_pairs: smoothing length h must be > 0");
-  const double rc = k_kernel_support * h;
-  if (box.ly < 2.0 * rc || box.lz < 2.0 * rc)
-    throw std::invalid_argument("coupling_pairs: ly and lz must be >= 4h (one periodic image per pair)");
-  const std::vector<IndexPair> idx = cross_pairs(dem_x, sph_x, box, rc);
   std::vector<CouplingPair> out;
-  out.reserve(idx.size());
-  for (const auto& [i, a] : idx) {
-    const double r = box.min_image(dem_x[i] - sph_x[a]).norm();
-    out.push_back({i, a, kernel_w(r, h)});
-  }
+  coupling_pairs(dem_x, sph_x, box, h, out);
   return out;
 }
 
@@ -62,6 +92,15 @@ ShepardField shepard_interpolate(std::size_t n_dem, const std::vector<CouplingPa
     out.eps[i] /= out.s[i];
   }
   return out;
+}
+
+std::vector<Vec3> generalised_buoyancy(std::size_t n_dem, const std::vector<CouplingPair>& pairs, double mass,
+                                       const std::vector<double>& s, const std::vector<Vec3>& a_fluid,
+                                       double particle_volume) {
+  std::vector<Vec3> f(n_dem, Vec3::Zero());
+  for (const CouplingPair& p : pairs) f[p.i] += (mass * p.w) * a_fluid[p.a];  // (m/rho) W x rho a
+  for (std::size_t i = 0; i < n_dem; ++i) f[i] *= particle_volume / s[i];
+  return f;
 }
 
 void add_back_coupling(const std::vector<CouplingPair>& pairs, const std::vector<Vec3>& force,

@@ -16,9 +16,9 @@ int count_along(double length, double dx) { return static_cast<int>(std::lround(
 // A second image along y (z) can lie within rc only when ly (lz) < 2 rc;
 // validation keeps ly, lz > rc, so no particle meets its own image.
 template <class F>
-void for_each_image(const Box& box, const Vec3& d, double rc, F&& f) {
+void for_each_image(const Box& box, const MinImageYZ& mi, const Vec3& d, double rc, F&& f) {
   if (std::abs(d.x()) >= rc) return;  // x is not periodic: cheap rejection first
-  const Vec3 m = box.min_image(d);
+  const Vec3 m(d.x(), mi.wrap_y(d.y()), mi.wrap_z(d.z()));  // branch-free minimum image
   const double rc2 = rc * rc, dx2 = m.x() * m.x();
   const int ky = box.ly < 2.0 * rc ? 1 : 0;
   const int kz = box.lz < 2.0 * rc ? 1 : 0;
@@ -95,19 +95,20 @@ SphPairs find_pairs(const FluidCell& cell) {
   const double rc = k_kernel_support * cell.h;
   const double reach = 0.5 * box.gap + cell.wall.depth.back() + cell.params.spacing;
   CellGrid grid(box, -reach, reach, rc);
+  const MinImageYZ mi(box);
   const auto& xf = cell.fluid.x;
   grid.bin(xf);
   for (std::uint32_t a = 0; a < xf.size(); ++a)
     grid.for_each_candidate(xf[a], [&](std::uint32_t b) {
       if (b <= a) return;
-      for_each_image(box, xf[a] - xf[b], rc,
+      for_each_image(box, mi, xf[a] - xf[b], rc,
                      [&](const Vec3& e, double r) { out.fluid_fluid.push_back({a, b, e, r}); });
     });
   const auto& xw = cell.wall.x;
   grid.bin(xw);
   for (std::uint32_t a = 0; a < xf.size(); ++a)
     grid.for_each_candidate(xf[a], [&](std::uint32_t b) {
-      for_each_image(box, xf[a] - xw[b], rc,
+      for_each_image(box, mi, xf[a] - xw[b], rc,
                      [&](const Vec3& e, double r) { out.fluid_wall.push_back({a, b, e, r}); });
     });
   return out;

@@ -26,17 +26,26 @@ void summation_density(FluidCell& c) {
 
 void wall_pressure(FluidCell& c) {
   const std::size_t nw = c.wall.size();
-  std::vector<double> sum_pw(nw, 0.0), sum_grw(nw, 0.0), sum_w(nw, 0.0);
+  const bool porous = !c.fluid.eps.empty();
+  std::vector<double> sum_pw(nw, 0.0), sum_grw(nw, 0.0), sum_w(nw, 0.0), sum_ew(porous ? nw : 0, 0.0);
   const Vec3 g(0.0, 0.0, c.params.body_force);
   for (const SphPair& pr : c.pairs.fluid_wall) {
     const double w = kernel_w(pr.r, c.h);
     sum_pw[pr.b] += c.fluid.p[pr.a] * w;
     sum_grw[pr.b] += c.fluid.rho[pr.a] * g.dot(-pr.r_ab) * w;  // r_wf = -r_ab
     sum_w[pr.b] += w;
+    if (porous) sum_ew[pr.b] += c.fluid.eps[pr.a] * w;
   }
   for (std::size_t b = 0; b < nw; ++b) {
     c.wall.p[b] = adami_wall_pressure(sum_pw[b], sum_grw[b], sum_w[b]);
+    // In the averaged equations the porosity field moves faster than the
+    // fluid particles rearrange, and the fluid next to a wall can go into
+    // tension; a wall extrapolating that tension pulls SPH particles through
+    // it. The wall does not adhere: its pressure is kept >= 0, so fluid in
+    // tension retracts toward the bulk instead.
+    if (porous) c.wall.p[b] = std::max(c.wall.p[b], 0.0);
     c.wall.rho[b] = eos_density(c.wall.p[b], c.params.density, c.c0);
+    if (porous && sum_w[b] > 0.0) c.wall.rho[b] *= sum_ew[b] / sum_w[b];
   }
 }
 
@@ -80,9 +89,16 @@ void finish_step(FluidCell& c, double dt) {
 void refresh(FluidCell& c) {
   c.pairs = find_pairs(c);
   summation_density(c);
+  update_pressures(c);
+}
+
+void update_pressures(FluidCell& c) {
   c.fluid.p.resize(c.fluid.size());
-  for (std::size_t a = 0; a < c.fluid.size(); ++a)
-    c.fluid.p[a] = eos_pressure(c.fluid.rho[a], c.params.density, c.c0);
+  const bool porous = !c.fluid.eps.empty(), labelled = !c.fluid.rest_density.empty();
+  for (std::size_t a = 0; a < c.fluid.size(); ++a) {
+    const double rho = porous ? c.fluid.rho[a] / c.fluid.eps[a] : c.fluid.rho[a];
+    c.fluid.p[a] = eos_pressure(rho, labelled ? c.fluid.rest_density[a] : c.params.density, c.c0);
+  }
   wall_pressure(c);
 }
 

@@ -14,9 +14,10 @@
 #include "mrf/forces/drag.hpp"
 #include "mrf/io/archive.hpp"
 #include "mrf/io/atomic_file.hpp"
-#include "mrf/observe/block_average.hpp"
 #include "mrf/observe/stress.hpp"
 #include "mrf/scene/dem_model.hpp"
+#include "mrf/scene/run_coupled.hpp"
+#include "mrf/scene/run_series.hpp"
 
 namespace mrf {
 
@@ -71,32 +72,12 @@ void print_limits(const TimeStepChoice& t, const RunSummary& s, const DemParams&
                  s.reynolds_number);
 }
 
-// Running sums of one time-series row, each step weighted by w (1 for the
-// fixed-step schemes, the step length for the adaptive implicit one).
-struct Row {
-  double tau_p = 0, vir_mag = 0, vir_con = 0, max_overlap = 0, e_dip = 0, e_hertz = 0;
-  double n = 0;
-  void add(const PairSums& p, const Box& box, double w) {
-    tau_p += w * wall_shear_stress(p.wall_fz, box);
-    vir_mag += w * virial_shear_stress(p.virial_mag_xz, box);
-    vir_con += w * virial_shear_stress(p.virial_con_xz, box);
-    max_overlap = std::max(max_overlap, p.max_overlap);
-    e_dip += w * p.energy_dipole;
-    e_hertz += w * p.energy_hertz;
-    n += w;
-  }
-};
-
-struct Series {
-  std::vector<double> total, particles, virial, mag, con, diff;
-};
-
 // What the DEM run loop carries from one row to the next (checkpointed).
 struct LoopState {
   long n = 0;                 // last completed step
   double row_start = 0;       // time at which the current row began (s)
   double strain_before = 0;   // strain reached by earlier sessions of this run
-  Series se;
+  StressSeries se;
   double max_overlap = 0;
   long pair_evals = 0;
   double elapsed_before = 0;  // wall seconds of earlier sessions of this run
@@ -105,7 +86,7 @@ struct LoopState {
     a.put(n);
     a.put(row_start);
     a.put(strain_before);
-    for (const auto* v : {&se.total, &se.particles, &se.virial, &se.mag, &se.con, &se.diff}) a.put(*v);
+    se.save(a);
     a.put(max_overlap);
     a.put(pair_evals);
     a.put(elapsed_before);
@@ -116,7 +97,7 @@ struct LoopState {
     a.get(n);
     a.get(row_start);
     a.get(strain_before);
-    for (auto* v : {&se.total, &se.particles, &se.virial, &se.mag, &se.con, &se.diff}) a.get(*v);
+    se.load(a);
     a.get(max_overlap);
     a.get(pair_evals);
     a.get(elapsed_before);
@@ -139,20 +120,6 @@ std::string scene_fingerprint(const SceneConfig& c) {
   out += std::string(to_string(c.model)) + ";" + to_string(c.integrator) + ";" + std::to_string(c.seed) + ";" +
          std::to_string(c.threads) + ";" + std::to_string(c.every) + ";" + std::to_string(c.frames);
   return out;
-}
-
-Measurement measure(const std::vector<double>& v) {
-  const BlockAverage b = block_average(v);
-  return {b.mean, b.sem, b.drift_z};
-}
-
-void write_frame(std::ofstream& out, const ShearCell& cell, double radius, double time) {
-  out << cell.free.size() + cell.walls.size() << "\n";
-  out << "Lattice=\"" << cell.box.gap + 2 * radius << " 0 0 0 " << cell.box.ly << " 0 0 0 "
-      << cell.box.lz << "\" Origin=\"" << -0.5 * cell.box.gap - radius
-      << " 0 0\" Properties=species:S:1:pos:R:3:radius:R:1 Time=" << time << "\n";
-  for (const auto& x : cell.free.x) out << "Fe " << x.x() << " " << x.y() << " " << x.z() << " " << radius << "\n";
-  for (const auto& x : cell.walls.x) out << "W " << x.x() << " " << x.y() << " " << x.z() << " " << radius << "\n";
 }
 
 }  // namespace
@@ -235,9 +202,7 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
   const SceneConfig& c = scene.config;
   if (c.model != ModelId::dem_stokes) {
     if (c.volume_fraction == 0) return run_fluid_only(scene, opt);
-    throw InputError("scene.model", to_string(c.model), scene.locate("scene.model"),
-                     "the coupled DEM-SPH models with particles are not implemented yet (issue #5); "
-                     "with particles.volume_fraction = 0 this model runs the fluid alone");
+    return run_coupled_scene(scene, opt);
   }
   if (c.threads > 0) omp_set_num_threads(c.threads);
   const DemParams p = dem_params(c);
@@ -255,12 +220,7 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
   const bool adaptive = ts.scheme == IntegratorId::implicit;
   const double t_end = c.strain / c.shear_rate;
   if (adaptive) model.set_stop_time(t_end);
-  const long every = c.every > 0 ? c.every : std::max(1L, s.steps / 2000);
-  const double rows_after_warmup = (1.0 - c.warmup_strain / c.strain) * static_cast<double>(s.steps / every);
-  if (rows_after_warmup < 32)
-    throw InputError("output.every", std::to_string(every), scene.locate("output.every"),
-                     "leaves only " + std::to_string(static_cast<long>(rows_after_warmup)) +
-                         " time-series rows after the warm-up; block averaging needs at least 32");
+  const long every = series_every(scene, s.steps);
   const long frame_every = c.frames > 0 ? std::max(1L, s.steps / c.frames) : 0;
   const std::string checkpoint = opt.out_dir.empty() ? "" : opt.out_dir + "/checkpoint.bin";
   const std::string fingerprint = scene_fingerprint(c);
@@ -289,9 +249,7 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
       ts_out.open(opt.out_dir + "/timeseries.csv", std::ios::app);
     } else {
       ts_out.open(opt.out_dir + "/timeseries.csv");
-      ts_out << "time_s,strain,stress_total_Pa,stress_particles_Pa,stress_fluid_Pa,"
-                "stress_virial_magnetic_Pa,stress_virial_contact_Pa,max_overlap_over_radius,"
-                "energy_dipole_J,energy_hertz_J\n";
+      write_series_header(ts_out);
     }
     ts_out.precision(10);
     if (frame_every > 0) {
@@ -299,7 +257,7 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
       frames_out.open(opt.out_dir + "/frames.xyz", resumed ? std::ios::app : std::ios::out);
     }
   }
-  Row row;
+  SeriesRow row;
   const auto t0 = std::chrono::steady_clock::now();
   auto last_report = t0, last_checkpoint = t0;
   long rows_since_checkpoint = 0;
@@ -309,28 +267,17 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
   while (running()) {
     ++n;
     model.step();
-    row.add(model.sums(), model.cell().box, adaptive ? model.dt() : 1.0);
+    row.add(model.sums(), model.cell().box, s.stress_fluid, s.stress_fluid, adaptive ? model.dt() : 1.0);
     st.pair_evals += model.sums().pair_evaluations;
     if (frame_every > 0 && n % frame_every == 0 && frames_out.is_open()) write_frame(frames_out, model.cell(), p.radius, model.time());
     const bool row_due = adaptive ? model.time() >= st.row_start + row_time * (1 - 1e-9) : n % every == 0;
     if (!row_due && running()) continue;
-    const double k = 1.0 / row.n, strain = model.time() * c.shear_rate;
-    const double tp = row.tau_p * k, vm = row.vir_mag * k, vc = row.vir_con * k;
+    const double strain = model.time() * c.shear_rate;
     st.max_overlap = std::max(st.max_overlap, row.max_overlap);
-    if (ts_out.is_open())
-      ts_out << model.time() << "," << strain << "," << tp + s.stress_fluid << "," << tp << ","
-             << s.stress_fluid << "," << vm << "," << vc << "," << row.max_overlap / p.radius << ","
-             << row.e_dip * k << "," << row.e_hertz * k << "\n";
-    if ((adaptive ? st.row_start * c.shear_rate : strain - row.n * ts.dt * c.shear_rate) >=
-        c.warmup_strain) {  // whole row after warm-up
-      st.se.total.push_back(tp + s.stress_fluid);
-      st.se.particles.push_back(tp);
-      st.se.virial.push_back(vm + vc);
-      st.se.mag.push_back(vm);
-      st.se.con.push_back(vc);
-      st.se.diff.push_back(tp - vm - vc);
-    }
-    row = Row{};
+    if (ts_out.is_open()) write_series_row(ts_out, model.time(), strain, row, p.radius);
+    if ((adaptive ? st.row_start * c.shear_rate : strain - row.n * ts.dt * c.shear_rate) >= c.warmup_strain)
+      st.se.push(row);  // whole row after warm-up
+    row = SeriesRow{};
     st.row_start = model.time();
     const auto now = std::chrono::steady_clock::now();
     ++rows_since_checkpoint;
@@ -380,12 +327,7 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
     s.extra["implicit_dt_mean"] = t_end / static_cast<double>(n);
   }
   if (!opt.quiet) std::fprintf(stderr, "\r  done: %ld steps in %.1f s%30s\n", s.steps, s.wall_seconds, "");
-  s.stress_total = measure(st.se.total);
-  s.stress_particles = measure(st.se.particles);
-  s.stress_virial = measure(st.se.virial);
-  s.stress_virial_magnetic = measure(st.se.mag);
-  s.stress_virial_contact = measure(st.se.con);
-  s.wall_minus_virial = measure(st.se.diff);
+  st.se.finish(s);
   s.max_overlap_over_radius = st.max_overlap / p.radius;
   s.neighbor_builds = model.lists().builds;
   s.particle_steps_per_second = static_cast<double>(s.n_particles * s.steps) / s.wall_seconds;

@@ -30,12 +30,16 @@ struct CouplingPair {
   double w;
 };
 
-// All DEM-SPH pairs closer than 2h (cell lists, minimum image in y and z).
-// Requires ly, lz >= 4h so that at most one periodic image interacts (the
-// neighbour search returns only the minimum image); throws
-// std::invalid_argument otherwise or if h <= 0.
+// All DEM-SPH pairs closer than 2h (cell lists, periodic in y and z). When
+// ly or lz < 4h a pair can interact through two periodic images; each image
+// is then its own entry (as in SphPairs), so scatter and gather stay
+// consistent in small boxes. Throws std::invalid_argument if h <= 0.
 std::vector<CouplingPair> coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x,
                                          const Box& box, double h);
+// Same, into `out` (cleared; its capacity is reused). Pairs come sorted by
+// DEM index i.
+void coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x, const Box& box, double h,
+                    std::vector<CouplingPair>& out);
 
 // Default porosity floor: eps below it (overlapping kernels of a dense packing)
 // would make the drag and eps-weighted densities blow up; 0.2 is well below
@@ -65,6 +69,18 @@ struct ShepardField {
 ShepardField shepard_interpolate(std::size_t n_dem, const std::vector<CouplingPair>& pairs, double mass,
                                  const std::vector<double>& rho, const std::vector<Vec3>& v,
                                  const std::vector<double>& eps);
+
+// Generalised buoyancy of the averaged equations (model A, REFERENCE §6):
+//   F_i = V_p (-grad p + div tau)_i = V_p sum_a (m/rho_a) W_ia (rho_a a_a) / s_i,
+// with a_a the SPH pressure + viscous acceleration of fluid particle a (m/s^2,
+// no body force, no coupling). The SPH sums divided by rho_a give
+// (-grad p + div tau)/rho_a, so rho_a a_a is the mixture's force density
+// whatever rho is (superficial or not): the buoyancy is V_p grad p, not
+// V_p grad p / eps (Robinson's rho_f form with superficial rho) and not 0
+// (model B). particle_volume V_p in m^3; returns N.
+std::vector<Vec3> generalised_buoyancy(std::size_t n_dem, const std::vector<CouplingPair>& pairs, double mass,
+                                       const std::vector<double>& s, const std::vector<Vec3>& a_fluid,
+                                       double particle_volume);
 
 // Back-reaction of the fluid-to-particle forces F_i (N) on the SPH particles:
 //   a_out[a] += -(1/rho_a) sum_i F_i W_ia / s_i   (m/s^2),

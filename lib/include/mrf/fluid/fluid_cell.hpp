@@ -23,8 +23,16 @@ struct FluidParticles {
   std::vector<Vec3> x;      // position (m), y and z wrapped into the box
   std::vector<Vec3> v;      // velocity (m/s)
   std::vector<Vec3> a_ext;  // extra acceleration (m/s^2): hook for the DEM back-reaction (REFERENCE §6)
-  std::vector<double> rho;  // summation density (kg/m^3)
+  std::vector<double> rho;  // summation density (kg/m^3); superficial eps rho_f when eps is set
   std::vector<double> p;    // pressure (Pa)
+  // Porosity eps in (0, 1] for the averaged equations of the coupled models
+  // (REFERENCE §6): the EOS takes the intrinsic density rho/eps. Empty for a
+  // pure fluid (eps = 1), so fluid-only runs are unchanged.
+  std::vector<double> eps;
+  // EOS reference of each particle's intrinsic density (kg/m^3), carried
+  // with the particle; empty = params.density. The coupled models set it to
+  // the intrinsic density of the start, which is then free of pressure.
+  std::vector<double> rest_density;
   std::size_t size() const { return x.size(); }
 };
 
@@ -75,8 +83,16 @@ FluidCell build_fluid_cell(const Box& box, const FluidParams& params);
 Vec3 wall_velocity(const FluidCell& cell, int side);
 
 // Recompute the neighbour pairs, summation densities, fluid pressures and
-// wall pressures at the current positions.
+// wall pressures at the current positions (pressure from the intrinsic
+// density rho/eps when fluid.eps is set).
 void refresh(FluidCell& cell);
+
+// Pressures and wall densities from the current densities and porosities,
+// without a new pair search (refresh() ends with it). With porosity the wall
+// particles take the Shepard mean eps_w of their fluid neighbours and the
+// superficial density eps_w x eos_density(p_w), like the fluid they mirror,
+// and a wall pressure clipped at 0 (no adhesion, see wcsph.cpp).
+void update_pressures(FluidCell& cell);
 
 // Neighbour pairs of the current positions (cell lists, periodic images).
 SphPairs find_pairs(const FluidCell& cell);

@@ -1,0 +1,129 @@
+// The two-way coupled DEM-SPH models `demsph_stokes` (model 2) and
+// `demsph_dd` (model 3), REFERENCE.md §4, §6: the DEM particles of model 1
+// (contact + dipole forces, same pair lists) in the SPH carrier of
+// fluid/wcsph.hpp, whose walls sit at the DEM wall planes and move with them.
+//
+// Averaged equations, model A (Anderson-Jackson; Robinson, Ramaioli & Luding
+// 2014): porosity eps_a = 1 - sum_i V_p W_ai at the SPH particles; the SPH
+// summation density is the superficial density eps rho_f (fluid particle
+// mass (1 - phi) rho_f dx^3, so the mean intrinsic density is rho_f); the
+// EOS takes the intrinsic density rho/eps. The SPH pressure and viscous sums
+// divided by the superficial density give the mixture's -grad p + div tau per
+// unit fluid mass; each particle then feels the generalised buoyancy
+// F_b = V_p (-grad p + div tau)_i (Shepard-interpolated), and its reaction
+// goes back to the fluid with the drag reaction. Together the fluid is left
+// with eps (-grad p) + ...: model A, not model B (pinned by the fixed-bed and
+// sedimentation tests in verification/coupling/).
+//
+// Time stepping, multi-rate: one explicit SPH step of dt_fluid holds
+// `substeps` DEM sub-steps (the Hertz contact step) that integrate the drag
+// exactly for particle + fluid parcel (integrate/coupled_steps.hpp) with the
+// interpolated fluid velocity, porosity and friction coefficient frozen over
+// the fluid step; the accumulated impulse (and buoyancy) is scattered back to
+// the SPH particles with the same kernel weights (coupling/exchange.hpp), so
+// momentum of particles + fluid + walls is conserved to round-off.
+#pragma once
+#include <vector>
+
+#include "mrf/coupling/exchange.hpp"
+#include "mrf/fluid/fluid_cell.hpp"
+#include "mrf/integrate/coupled_steps.hpp"
+#include "mrf/scene/dem_forces.hpp"
+#include "mrf/scene/shear_cell.hpp"
+
+namespace mrf {
+
+enum class CoupledDrag { stokes, di_felice };
+
+// Sums over the DEM sub-steps of one fluid step (for the stress observables).
+struct CoupledStepSums {
+  PairSums dem;                          // wall_fz and virials averaged over sub-steps; max_overlap the max
+  double fluid_stress = 0;               // SPH wall shear stress at the start of the step (Pa)
+  // Virial shear stress -(1/V) sum r_x F_z of the fluid pairs (SPH pressure
+  // + Morris viscous, fluid-wall pairs included) and of the particle-fluid
+  // exchange (each particle's force split over its SPH neighbours with the
+  // scatter weights), Pa: with the particle pair virial, the volume side of
+  // the wall stress (REFERENCE §7).
+  double fluid_virial = 0, exchange_virial = 0;
+  double eps_min = 1, eps_max = 1;       // porosity range at the SPH particles
+  std::size_t eps_clamped = 0;           // SPH particles at the porosity floor
+  long wall_reflections = 0;             // SPH particles reflected at a wall plane since the start
+};
+
+class CoupledModel {
+ public:
+  // `fluid` built for the same box (fluid mass already scaled, see
+  // build_coupled_fluid). dt_fluid (s) is split into `substeps` DEM sub-steps.
+  CoupledModel(ShearCell cell, const DemParams& params, FluidCell fluid, CoupledDrag law, double dt_fluid,
+               int substeps);
+
+  void step();
+
+  const ShearCell& cell() const { return cell_; }
+  const FluidCell& fluid() const { return fluid_; }
+  const DemParams& params() const { return p_; }
+  const DemPairLists& lists() const { return lists_; }
+  const CoupledStepSums& sums() const { return sums_; }
+  double dt_fluid() const { return dt_; }
+  double dt_dem() const { return dt_ / substeps_; }
+  int substeps() const { return substeps_; }
+  double time() const { return time_; }
+  long steps() const { return steps_; }
+  long dem_steps() const { return steps_ * substeps_; }
+
+  // Total momentum of particles + fluid (kg m/s) and the impulse the walls
+  // and body forces have given them since the start (N s): momentum() -
+  // momentum at start equals external_impulse() to round-off.
+  Vec3 momentum() const;
+  const Vec3& external_impulse() const { return external_impulse_; }
+
+  // Friction coefficient and fluid velocity at the particles of the last step.
+  const ParcelCoupling& coupling() const { return coupling_; }
+  const std::vector<Vec3>& fluid_velocity_at_particles() const { return u_at_; }
+  const std::vector<double>& porosity_at_particles() const { return eps_at_; }
+  // Force per particle besides drag and the DEM forces (buoyancy), N.
+  const std::vector<Vec3>& buoyancy() const { return buoyancy_; }
+  // Constant extra force on every free particle (N), e.g. for settling tests.
+  void set_body_force(const Vec3& f) { body_force_ = f; }
+
+ private:
+  void update_coupling_pairs();
+  void prepare_coupling(const std::vector<Vec3>& a_fluid);
+  void update_dem_forces();
+  void dem_substep();
+  void check_dem() const;
+
+  ShearCell cell_;
+  DemParams p_;
+  FluidCell fluid_;
+  CoupledDrag law_;
+  double dt_;
+  int substeps_;
+  DemPairLists lists_;
+  ForceBuffers buffers_;
+  std::vector<CouplingPair> pairs_, solid_pairs_;  // real particles; with wall mirror images
+  std::vector<Vec3> solid_;
+  ShepardField shepard_;
+  std::vector<Vec3> u_at_, buoyancy_, f_old_, f_new_;
+  std::vector<double> eps_at_;
+  ParcelCoupling coupling_;
+  ParcelState parcel_;
+  CoupledStepSums sums_;
+  Vec3 external_impulse_ = Vec3::Zero();
+  Vec3 body_force_ = Vec3::Zero();
+  double overlap_limit_;
+  double time_ = 0;
+  long steps_ = 0;
+};
+
+// The SPH carrier of a coupled scene: build_fluid_cell on the scene box with
+// the fluid particle mass scaled by (1 - phi) (phi of the DEM particles), so
+// that the superficial density of the rest state is (1 - phi) rho_f.
+FluidCell build_coupled_fluid(const SceneConfig& c, const ShearCell& cell);
+
+// Time-step limit of the explicit SPH step in the averaged equations: the
+// viscous bound 0.125 h^2 eps_min rho_f / eta (the superficial density
+// eps rho_f carries the momentum) beside the CFL bound (s).
+double coupled_viscous_limit(const FluidCell& f, double eps_min);
+
+}  // namespace mrf
