@@ -139,25 +139,34 @@ def main(argv):
         fig, axs = plt.subplots(1, 2, figsize=(11, 4.5))
         for k, d in dev.items():
             p = d["points"]
-            for ax, xkey in zip(axs, ("mason", "share")):
-                ax.errorbar([q[xkey] for q in p], [100 * q["deviation"] for q in p],
-                            yerr=[100 * q["err"] for q in p], fmt="o-", ms=4, capsize=3, color=COLOR[k], label=LABEL[k])
-            for lvl, key in ((10, "crossing_10"), (20, "crossing_20")):
-                c = d[key]
-                if c["found"] and k == "dem_stokes":
-                    axs[0].axvline(c["mason"], color="k", ls="--" if lvl == 10 else ":", lw=1,
-                                   label=f"model 1 off by {lvl} %: Mn = {c['mason']:.2g}")
-                    axs[1].axvline(c["share"], color="k", ls="--" if lvl == 10 else ":", lw=1,
-                                   label=f"criterion s_{lvl} = {c['share']:.2f}")
-        for ax in axs:
-            for lvl in (10, 20):
-                ax.axhspan(-lvl, lvl, color="gray", alpha=0.08)
-            ax.axhline(0, color="k", lw=0.5)
-            ax.legend(fontsize=7)
+            axs[0].errorbar([q["mason"] for q in p], [100 * q["deviation"] for q in p],
+                            yerr=[100 * q["err"] for q in p], fmt="o-", ms=4, capsize=3, color=COLOR[k],
+                            label=LABEL[k] + " (wall stress)")
+            if k == "dem_stokes":
+                axs[0].plot([q["mason"] for q in p], [100 * q["volume_deviation"] for q in p], "s--", ms=4,
+                            color=COLOR[k], label="1: volume stress (pair virial + eta gdot)")
+        for h, mk in [(sweep_dir, "o")] + [(x, "^") for x in heldout]:
+            path = os.path.join(h, "criterion.json")
+            if not os.path.exists(path):
+                continue
+            d1 = json.load(open(path)).get("deviation_from_demsph_dd", {}).get("dem_stokes")
+            if d1:
+                axs[1].plot([100 * q["mismatch"] for q in d1["points"]], [-100 * q["deviation"] for q in d1["points"]],
+                            mk, ms=6, label=os.path.basename(os.path.normpath(h)))
+        axs[1].plot([0, 100], [0, 100], "k:", lw=1, label="-deviation = mismatch")
+        for lvl in (10, 20):
+            axs[1].axvline(lvl, color="gray", ls="--", lw=0.8)
+            axs[1].axhline(lvl, color="gray", ls="--", lw=0.8)
+        axs[0].axhspan(-10, 10, color="gray", alpha=0.1)
+        axs[0].axhspan(-20, 20, color="gray", alpha=0.06)
+        axs[0].axhline(0, color="k", lw=0.5)
         axs[0].set(xscale="log", xlabel=f"Mason number ({MN_CONVENTION})", ylabel="tau_model / tau_3 - 1 (%)",
                    title="deviation from model 3 (DEM-SPH Di Felice)")
-        axs[1].set(xlabel="hydrodynamic share of the model's stress, s = tau_fluid / tau_total",
-                   ylabel="tau_model / tau_3 - 1 (%)", title="the same against the hydrodynamic share")
+        axs[1].set(xlabel="model-1 self-consistency mismatch m = 1 - tau_wall / tau_volume (%)",
+                   ylabel="model 1 shortfall 1 - tau_1 / tau_3 (%)",
+                   title="criterion: model 1 within a of model 3 iff |m| < a")
+        for ax in axs:
+            ax.legend(fontsize=7)
         axs[0].text(0.01, -0.2, plabel, transform=axs[0].transAxes, fontsize=6)
         save(fig, out, "deviation")
 
@@ -211,30 +220,40 @@ def main(argv):
     md += ["", f"Drift check: {len(drift)} of {len(ok)} runs have |z| > 3 between the halves of the averaging window"
            + (": " + ", ".join(r["dir"] for r in drift) if drift else "."), ""]
     if dev:
-        md += ["## Deviation from model 3 and the criterion", ""]
+        md += ["## Deviation from model 3 and the criterion", "",
+               "| model | Mn | tau/tau_3 - 1 | ± | hydrodynamic share s | mismatch m = 1 - tau_wall/tau_volume | "
+               "volume stress/tau_3 - 1 |", "|---|---|---|---|---|---|---|"]
+        for k, d in dev.items():
+            for q in d["points"]:
+                md.append(f"| {k} | {q['mason']:.3g} | {q['deviation']:+.3f} | {q['err']:.3f} | {q['share']:.3f} | "
+                          f"{q['mismatch']:+.3f} | {q['volume_deviation']:+.3f} |")
+        md.append("")
         for k, d in dev.items():
             for lvl, key in ((10, "crossing_10"), (20, "crossing_20")):
                 c = d[key]
-                md.append(f"- {k}: " + (f"off by {lvl} % from Mn = {c['mason']:.3g} (share s = {c['share']:.3f})"
-                                        if c["found"] else f"within {lvl} % over the whole sweep"))
-        if "derived_thresholds" in crit:
-            t = crit["derived_thresholds"]
-            md += ["", f"**Criterion.** Model 1 is within 10 % of model 3 where its hydrodynamic share "
-                       f"s = tau_fluid/tau_total < {t['share_10']:.3f} (20 %: s < {t['share_20']:.3f}); for this scene "
-                       f"that is Mn < {t['mason_10']:.3g} (20 %: Mn < {t['mason_20']:.3g}). "
-                       f"`mrf criterion RUN_DIR --thresholds FILE` prints the verdict for one DEM-Stokes run."]
+                if c.get("below_range"):
+                    md.append(f"- {k}: off by more than {lvl} % already at the lowest Mn of the sweep ({c['mason']:.3g})")
+                elif c["found"]:
+                    md.append(f"- {k}: off by {lvl} % from Mn = {c['mason']:.3g} (share s = {c['share']:.3f})")
+                else:
+                    md.append(f"- {k}: within {lvl} % over the whole sweep")
+            if "consistency_hit_rate" in d:
+                md.append(f"- {k}: self-consistency verdicts right: {100 * d['consistency_hit_rate']:.0f} %")
     for h in heldout:
-        if not os.path.exists(os.path.join(h, "criterion.json")):
-            md += ["", f"### Held-out conditions: `{h}`: no criterion.json (sweep or thresholds missing)"]
+        path = os.path.join(h, "criterion.json")
+        if not os.path.exists(path):
+            md += ["", f"### Held-out conditions: `{h}`: no criterion.json"]
             continue
-        hc = json.load(open(os.path.join(h, "criterion.json")))
-        v = hc.get("verdicts", {})
+        hc = json.load(open(path))
+        d1 = hc.get("deviation_from_demsph_dd", {}).get("dem_stokes", {})
         md += ["", f"### Held-out conditions: `{os.path.basename(os.path.normpath(h))}`", "",
-               f"phi = {hc['volume_fraction']:.2f}; hit rate {v.get('hit_rate', float('nan')):.2f}", "",
-               "| Mn | share s | deviation | adequate (10 %) | hit | adequate (20 %) | hit |", "|---|---|---|---|---|---|---|"]
-        for q in v.get("points", []):
-            md.append(f"| {q['mason']:.3g} | {q['share']:.3f} | {q.get('deviation', float('nan')):+.3f} | "
-                      f"{q['adequate_10']} | {q.get('hit_10', '')} | {q['adequate_20']} | {q.get('hit_20', '')} |")
+               f"phi = {hc['volume_fraction']:.2f}; self-consistency verdicts right: "
+               f"{100 * d1.get('consistency_hit_rate', float('nan')):.0f} %", "",
+               "| Mn | tau_1/tau_3 - 1 | mismatch m | verdict 10 % right | verdict 20 % right | volume stress/tau_3 - 1 |",
+               "|---|---|---|---|---|---|"]
+        for q in d1.get("points", []):
+            md.append(f"| {q['mason']:.3g} | {q['deviation']:+.3f} | {q['mismatch']:+.3f} | {q.get('consistency_hit_10', '')} | "
+                      f"{q.get('consistency_hit_20', '')} | {q['volume_deviation']:+.3f} |")
     with open(os.path.join(out, "study.md"), "w") as f:
         f.write("\n".join(md) + "\n")
     print(f"wrote {out}/study.md and figures")

@@ -62,9 +62,17 @@ int run_directory(const std::string& dir, const Thresholds* t) {
   if (j.at("model") != "dem_stokes")
     throw mrf::InputError("model", j.at("model").dump(), dir + "/summary.json",
                           "the criterion is read off a model-1 (dem_stokes) run");
-  const double share = j.at("stress_fluid").get<double>() / j.at("stress_total").get<double>();
+  const double total = j.at("stress_total").get<double>();
+  const double share = j.at("stress_fluid").get<double>() / total;
+  if (j.contains("stress_virial_total")) {
+    const double m = 1.0 - total / j["stress_virial_total"].get<double>();
+    std::printf("%s: self-consistency mismatch m = 1 - tau_wall/tau_volume = %.3f -> model 1 %s within 10 %%, %s "
+                "within 20 %% of the two-way model (|m| < level)\n",
+                dir.c_str(), m, std::abs(m) < 0.1 ? "ADEQUATE" : "NOT adequate",
+                std::abs(m) < 0.2 ? "ADEQUATE" : "NOT adequate");
+  }
   if (!t) {
-    std::printf("%s: hydrodynamic share s = %.3g (give --thresholds FILE for a verdict)\n", dir.c_str(), share);
+    std::printf("%s: hydrodynamic share s = %.3g (give --thresholds FILE for the share verdict)\n", dir.c_str(), share);
     return 0;
   }
   print_verdict(dir.c_str(), share, *t);
@@ -114,14 +122,37 @@ int criterion_command(const std::string& path, const std::string& thresholds_pat
     if (!have_ref || !curves.count(m)) continue;
     const auto dev = mrf::deviation(curves[m], curves["demsph_dd"]);
     ordered_json rows = ordered_json::array();
-    for (const auto& d : dev)
-      rows.push_back({{"mason", d.mason}, {"deviation", d.value}, {"err", d.err}, {"share", d.share}});
+    int hits = 0, tested = 0;
+    for (const auto& d : dev) {
+      ordered_json r{{"mason", d.mason}, {"deviation", d.value}, {"err", d.err}, {"share", d.share},
+                     {"mismatch", d.mismatch}, {"volume_deviation", d.volume_value}};
+      if (std::string(m) == "dem_stokes")
+        for (double level : {0.1, 0.2}) {  // the self-consistency verdict against the actual deviation
+          const bool predicted = std::abs(d.mismatch) < level, actual = std::abs(d.value) < level;
+          r[level == 0.1 ? "consistency_hit_10" : "consistency_hit_20"] = predicted == actual;
+          hits += predicted == actual;
+          ++tested;
+        }
+      rows.push_back(r);
+      std::printf("%-14s Mn = %-6.3g tau/tau_3 - 1 = %+.3f +- %.3f, share s = %.3f, mismatch m = %+.3f, "
+                  "volume stress/tau_3 - 1 = %+.3f\n",
+                  m, d.mason, d.value, d.err, d.share, d.mismatch, d.volume_value);
+    }
     out["deviation_from_demsph_dd"][m]["points"] = rows;
+    if (tested) {
+      out["deviation_from_demsph_dd"][m]["consistency_hit_rate"] = static_cast<double>(hits) / tested;
+      std::printf("%-14s self-consistency criterion (|m| < level <=> |tau_1/tau_3 - 1| < level): %d of %d verdicts "
+                  "right\n", m, hits, tested);
+    }
     for (double level : {0.1, 0.2}) {
       const auto c = mrf::first_crossing(dev, level);
       const std::string key = level == 0.1 ? "crossing_10" : "crossing_20";
-      out["deviation_from_demsph_dd"][m][key] = {{"found", c.found}, {"mason", c.mason}, {"share", c.share}};
-      if (c.found)
+      out["deviation_from_demsph_dd"][m][key] = {
+          {"found", c.found}, {"below_range", c.below_range}, {"mason", c.mason}, {"share", c.share}};
+      if (c.below_range)
+        std::printf("%-14s departs from demsph_dd by more than %2.0f %% already at the lowest Mn = %.3g\n", m,
+                    100 * level, c.mason);
+      else if (c.found)
         std::printf("%-14s departs from demsph_dd by %2.0f %% at Mn = %.3g (hydrodynamic share s = %.3g)\n", m,
                     100 * level, c.mason, c.share);
       else
@@ -130,7 +161,8 @@ int criterion_command(const std::string& path, const std::string& thresholds_pat
   }
   if (have_ref && curves.count("dem_stokes")) {
     const auto& d = out["deviation_from_demsph_dd"]["dem_stokes"];
-    if (d["crossing_10"]["found"] && d["crossing_20"]["found"])
+    if (d["crossing_10"]["found"] && d["crossing_20"]["found"] && !d["crossing_10"]["below_range"] &&
+        !d["crossing_20"]["below_range"])
       out["derived_thresholds"] = {{"share_10", d["crossing_10"]["share"]}, {"share_20", d["crossing_20"]["share"]},
                                    {"mason_10", d["crossing_10"]["mason"]}, {"mason_20", d["crossing_20"]["mason"]}};
   }

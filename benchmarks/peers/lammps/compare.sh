@@ -75,7 +75,9 @@ mrf="$build/mrf"
 
 # --- scene export ---------------------------------------------------------------
 prefix="$work/scene"
-run "$mrf" export-lammps "$scene" --set "drive.mason=$mason" --out "$prefix" > "$work/export.log"
+# mrf's explicit scheme is the one compared step for step (its dt is the one
+# LAMMPS is given in (a)); the implicit scheme enters (b) as a second mrf entry.
+run "$mrf" export-lammps "$scene" --set "drive.mason=$mason" --set numerics.integrator=verlet_exp --out "$prefix" > "$work/export.log"
 pget() { awk -v k="$1" '$1=="variable" && $2==k {print $4}' "$prefix.params"; }
 dt_mrf="$(pget dt_mrf)"
 gdot="$(pget shear_rate)"
@@ -87,10 +89,11 @@ calc() { python3 -c "import math; print(repr($1))"; }
 # mrf runs N steps when drive.strain = (N - 1/2) gdot dt (it takes ceil(strain/(gdot dt))).
 strain_for_steps() { calc "($1 - 0.5) * $gdot * $2"; }
 
-mrf_run() {  # name strain warmup [extra --set ...]
+mrf_run() {  # name strain warmup [extra --set ...]; integrator $mrf_int (default verlet_exp)
   local name="$1" s="$2" w="$3"; shift 3
   run "$mrf" run "$scene" --set "drive.mason=$mason" --set "drive.strain=$s" \
-      --set "drive.warmup_strain=$w" "$@" --out "$work/$name" > "$work/$name.stdout" 2> "$work/$name.stderr"
+      --set "drive.warmup_strain=$w" --set "numerics.integrator=${mrf_int:-verlet_exp}" "$@" \
+      --out "$work/$name" > "$work/$name.stdout" 2> "$work/$name.stderr"
 }
 lmp_run() {  # name nsteps dt nave thermo_every
   run "$lmp" -in "$here/in.mrf_shear" -var dir "$here" -var prefix "$prefix" -var nsteps "$2" \
@@ -202,8 +205,9 @@ for ((r = 1; r <= reps; r++)); do
   if (( r % 2 == 1 )); then order="mrf lmp"; else order="lmp mrf"; fi
   for code in $order; do
     if [[ "$code" == mrf ]]; then
-      echo "  [b] rep $r: mrf to strain $strain at its automatic dt"
+      echo "  [b] rep $r: mrf to strain $strain at its automatic dt (verlet_exp, then implicit)"
       mrf_run "b_mrf_$r" "$strain" "$window"
+      mrf_int=implicit mrf_run "b_mrf_implicit_$r" "$strain" "$window"
     else
       echo "  [b] rep $r: LAMMPS to strain $strain: $nb_lmp steps at dt = $dt_lmp s"
       lmp_run "b_lmp_$r" "$nb_lmp" "$dt_lmp" 10 "$nb_lmp"
@@ -313,7 +317,7 @@ P(f"(b) Time to one strain unit at Mn = {float(mason):g} (shear rate {gdot:.5g} 
 P("")
 P("| rep | code | dt (s) | steps run | loop (s) | steps per strain | wall time per strain (s, extrapolated) |")
 P("|---:|---|---:|---:|---:|---:|---:|")
-ratios_b = []
+ratios_b, ratios_bi = [], []
 for r in range(1, reps + 1):
     bm = mrf_sum(f"b_mrf_{r}"); bl = lmp_log(f"b_lmp_{r}")
     assert bm["threads"] == 1, "mrf did not run on one thread"
@@ -321,6 +325,11 @@ for r in range(1, reps + 1):
     t1_lmp = bl["loop"] / (bl["steps"] * dt_lmp * gdot)
     ratios_b.append(t1_lmp / t1_mrf)
     P(f"| {r} | mrf ({bm['integrator']}) | {bm['dt']:.4g} | {bm['steps']} | {bm['wall_seconds']:.1f} | {1/(bm['dt']*gdot):.0f} | {t1_mrf:.0f} |")
+    bi = mrf_sum(f"b_mrf_implicit_{r}")
+    t1_imp = bi["wall_seconds"] / bi["strain"]
+    ratios_bi.append(t1_lmp / t1_imp)
+    P(f"| {r} | mrf (implicit, mean dt) | {bi['strain'] / (gdot * bi['steps']):.4g} | {bi['steps']} | {bi['wall_seconds']:.1f} | "
+      f"{bi['steps'] / bi['strain']:.0f} | {t1_imp:.0f} |")
     P(f"| {r} | LAMMPS | {dt_lmp:.4g} | {bl['steps']} | {bl['loop']:.1f} | {1/(dt_lmp*gdot):.0f} | {t1_lmp:.0f} |")
 bm = mrf_sum("b_mrf_1")
 P("")
@@ -328,7 +337,9 @@ P(f"Basis of dt: mrf {bm['dt']:.4g} s = {safety:.2g} x its {bm['dt_bound_by']} l
   f"(expected overlap/R {h_over_r:g}); LAMMPS {dt_lmp:.4g} s = min(0.2 tau_p = {dt_drag:.3g} s, {safety:.2g} x {dt_contact:.3g} s, "
   f"the stability limit of velocity Verlet with the explicit drag on the same contact at the same overlap).")
 P(f"Ratio LAMMPS/mrf wall time per strain unit (>1: mrf faster): "
-  + ", ".join(f"{x:.2f}" for x in ratios_b) + f"; median {median(ratios_b):.2f} (dt ratio mrf/LAMMPS {bm['dt']/dt_lmp:.2f}).")
+  + ", ".join(f"{x:.2f}" for x in ratios_b) + f"; median {median(ratios_b):.2f} (dt ratio mrf/LAMMPS {bm['dt']/dt_lmp:.2f}). "
+  f"With mrf's implicit inertialess scheme: " + ", ".join(f"{x:.2f}" for x in ratios_bi)
+  + f"; median {median(ratios_bi):.2f}.")
 P("")
 
 # stability probe

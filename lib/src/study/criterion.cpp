@@ -45,6 +45,8 @@ SweepTable read_sweep_csv(const std::string& path) {
     s.stress = std::stod(c[col["stress_total"]]);
     s.err = std::stod(c[col["stress_total_err"]]);
     s.stress_fluid = std::stod(c[col["stress_fluid"]]);
+    if (col.count("stress_virial_total") && !c[col["stress_virial_total"]].empty())
+      s.stress_volume = std::stod(c[col["stress_virial_total"]]);
     t.magnetization = std::stod(c[col["magnetization"]]);
     t.volume_fraction = std::stod(c[col["volume_fraction"]]);
     // eta from the first row: tau_fluid of model 1 is eta gdot, and gdot follows from Mn
@@ -66,6 +68,8 @@ std::vector<Deviation> deviation(const std::vector<FlowPoint>& model, const std:
         d.value = q - 1.0;
         d.err = std::abs(q) * std::sqrt(std::pow(m.err / m.stress, 2) + std::pow(r.err / r.stress, 2));
         d.share = m.stress_fluid / m.stress;
+        d.mismatch = m.stress_volume != 0 ? 1.0 - m.stress / m.stress_volume : 0.0;
+        d.volume_value = m.stress_volume != 0 ? m.stress_volume / r.stress - 1.0 : 0.0;
         out.push_back(d);
       }
   return out;
@@ -78,6 +82,7 @@ Crossing first_crossing(const std::vector<Deviation>& d, double level) {
     if (a < level) continue;
     c.found = true;
     if (i == 0) {  // already above at the lowest Mn: the crossing lies below the sweep
+      c.below_range = true;
       c.mason = d[0].mason;
       c.share = d[0].share;
       return c;

@@ -25,6 +25,7 @@ std::vector<FlowPoint> seed_average(const std::vector<StressSample>& samples) {
     for (const auto* s : group) {
       p.stress += s->stress / n;
       p.stress_fluid += s->stress_fluid / n;
+      p.stress_volume += s->stress_volume / n;
       sum_err2 += s->err * s->err;
     }
     double ss = 0;

@@ -1,10 +1,14 @@
 // The applicability criterion of model 1 (issue 6): where the one-way
 // DEM-Stokes stress departs from the two-way DEM-SPH-DD stress, expressed
-// through a number a modeller can read off a single model-1 run: the
-// hydrodynamic share s = tau_fluid / tau_total (= eta gdot / tau for the
-// imposed Couette flow). Model 1 is called adequate at accuracy a where
-// s < s_a, s_a being the share at which |tau_1/tau_3 - 1| first reaches a
-// (interpolated in log Mn between sweep points).
+// through numbers a modeller can read off a single model-1 run:
+//  - the hydrodynamic share s = tau_fluid / tau_total (= eta gdot / tau for
+//    the imposed Couette flow): model 1 adequate at accuracy a where s < s_a,
+//    s_a the share at which |tau_1/tau_3 - 1| first reaches a (log-interpolated
+//    in Mn); undefined when the first sweep point already misses a;
+//  - the self-consistency mismatch m = 1 - tau_wall / tau_volume of the run
+//    (wall stress against pair virial + eta gdot): the imposed fluid of model 1
+//    absorbs the stress of clusters that do not reach a wall, which the
+//    two-way models return to the walls; model 1 adequate at a where |m| < a.
 #pragma once
 #include <map>
 #include <string>
@@ -26,6 +30,8 @@ struct Deviation {
   double mason = 0;
   double value = 0, err = 0;  // tau_m / tau_ref - 1 and its standard error
   double share = 0;           // hydrodynamic share of model m, tau_fluid / tau_total
+  double mismatch = 0;        // 1 - tau_m / tau_volume,m (0 when the volume stress is unknown)
+  double volume_value = 0;    // tau_volume,m / tau_ref - 1 (the volume-side estimate of the reference)
 };
 
 // tau_m/tau_ref - 1 at the Mason numbers both flow curves have.
@@ -33,6 +39,7 @@ std::vector<Deviation> deviation(const std::vector<FlowPoint>& model, const std:
 
 struct Crossing {
   bool found = false;
+  bool below_range = false;  // already past the level at the lowest Mn of the sweep
   double mason = 0;  // first Mn (from below) where |deviation| reaches the level, log-interpolated
   double share = 0;  // hydrodynamic share there, interpolated the same way
 };

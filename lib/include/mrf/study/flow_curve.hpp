@@ -21,6 +21,7 @@ struct StressSample {
   std::uint64_t seed = 0;
   double stress = 0, err = 0;  // Pa, standard error within the run
   double stress_fluid = 0;     // Pa, the hydrodynamic part (eta gdot for model 1)
+  double stress_volume = 0;    // Pa, volume-side total: pair virial + fluid (stress_virial_total)
 };
 
 // Seed average at one Mason number.
@@ -31,6 +32,7 @@ struct FlowPoint {
   double seed_scatter = 0;  // sample standard deviation between seeds (Pa); 0 for one seed
   double within_err = 0;    // sqrt(sum err_i^2)/n (Pa)
   double stress_fluid = 0;  // mean hydrodynamic part (Pa)
+  double stress_volume = 0; // mean volume-side total (Pa)
   int seeds = 0;
 };
 
