@@ -22,6 +22,7 @@ struct StressSample {
   double stress = 0, err = 0;  // Pa, standard error within the run
   double stress_fluid = 0;     // Pa, the hydrodynamic part (eta gdot for model 1)
   double stress_volume = 0;    // Pa, volume-side total: pair virial + fluid (stress_virial_total)
+  double stokes = 0;           // Stokes number tau_p gdot of the run
 };
 
 // Seed average at one Mason number.
@@ -33,6 +34,7 @@ struct FlowPoint {
   double within_err = 0;    // sqrt(sum err_i^2)/n (Pa)
   double stress_fluid = 0;  // mean hydrodynamic part (Pa)
   double stress_volume = 0; // mean volume-side total (Pa)
+  double stokes = 0;        // Stokes number (the same for every seed)
   int seeds = 0;
 };
 
