@@ -224,6 +224,10 @@ def main(argv):
     drift = [r for r in ok if abs(num(r, "stress_total_drift_z")) > 3]
     md += ["", f"Drift check: {len(drift)} of {len(ok)} runs have |z| > 3 between the halves of the averaging window"
            + (": " + ", ".join(r["dir"] for r in drift) if drift else "."), ""]
+    mser = [r for r in ok if num(r, "steady_mser_discard_fraction") > 0.2]
+    md += [f"Steady-state check (MSER-5 on the averaging window): {len(mser)} of {len(ok)} runs would still discard "
+           "more than 20 % of the window as transient" + (": " + ", ".join(
+               f"{r['dir']} ({100 * num(r, 'steady_mser_discard_fraction'):.0f} %)" for r in mser) if mser else "."), ""]
     d1 = dev.get("dem_stokes")
     if d1:
         pts = d1["points"]

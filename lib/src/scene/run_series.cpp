@@ -5,6 +5,7 @@
 
 #include "mrf/error.hpp"
 #include "mrf/observe/block_average.hpp"
+#include "mrf/observe/steady_state.hpp"
 #include "mrf/observe/stress.hpp"
 
 namespace mrf {
@@ -66,6 +67,10 @@ void StressSeries::finish(RunSummary& s) const {
   s.extra["stress_virial_total"] = vt.mean;
   s.extra["stress_virial_total_err"] = vt.err;
   s.extra["stress_virial_fluid"] = measure(vir_fluid_).mean;
+  // steady-state check: the share of the averaging window MSER-5 would still
+  // discard as transient (0 = steady from the end of the warm-up)
+  s.extra["steady_mser_discard_fraction"] =
+      total_.empty() ? 0.0 : static_cast<double>(mser_truncation(total_)) / static_cast<double>(total_.size());
 }
 
 void write_series_header(std::ostream& out) {

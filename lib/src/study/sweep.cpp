@@ -201,7 +201,7 @@ bool point_finished(const std::string& point_dir) {
 
 std::string sweep_csv(const std::vector<SweepPoint>& points, const std::string& out_dir) {
   static const char* numbers[] = {"shear_rate", "strain", "warmup_strain", "stress_total", "stress_total_err",
-                                  "stress_total_drift_z", "stress_particles", "stress_particles_err", "stress_fluid",
+                                  "stress_total_drift_z", "steady_mser_discard_fraction", "stress_particles", "stress_particles_err", "stress_fluid",
                                   "stress_virial", "stress_virial_err", "stress_virial_total", "stress_virial_total_err",
                                   "stress_virial_magnetic",
                                   "stress_virial_contact", "n_particles", "n_fluid", "dt", "steps", "wall_seconds",
