@@ -221,6 +221,15 @@ def main(argv):
         for q in crit["models"][k]["points"]:
             md.append(f"| {k} | {q['mason']:.3g} | {q['stress']:.4g} | {q['err']:.2g} | {q['seed_scatter']:.2g} | "
                       f"{q['within_err']:.2g} | {q['seeds']} | {q['stress_fluid'] / q['stress']:.3f} |")
+    md += ["## Cost per strain unit (wall seconds, mean over seeds, one core per run, two runs at a time)", "",
+           "| Mn | " + " | ".join(models) + " | " + " | ".join(f"{k}/dem_stokes" for k in models if k != "dem_stokes") + " |",
+           "|---|" + "---|" * (2 * len(models) - 1)]
+    for mn in sorted({p_[0] for k in models for p_ in cost[k]}):
+        means = {k: sum(c for m_, c in cost[k] if m_ == mn) / max(1, sum(1 for m_, _ in cost[k] if m_ == mn))
+                 for k in models}
+        ratios = [f"{means[k] / means['dem_stokes']:.2f}" for k in models if k != "dem_stokes" and "dem_stokes" in means]
+        md.append(f"| {mn:.3g} | " + " | ".join(f"{means[k]:.3g}" for k in models) + " | " + " | ".join(ratios) + " |")
+    md.append("")
     drift = [r for r in ok if abs(num(r, "stress_total_drift_z")) > 3]
     md += ["", f"Drift check: {len(drift)} of {len(ok)} runs have |z| > 3 between the halves of the averaging window"
            + (": " + ", ".join(r["dir"] for r in drift) if drift else "."), ""]
