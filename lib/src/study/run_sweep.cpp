@@ -1,5 +1,6 @@
 // The sweep driver: estimate, run the unfinished points of this rank, report
 // progress, collect sweep.csv.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -126,7 +127,7 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
     if (!opt.quiet) {
       const double scale = spent_estimated > 0 ? spent_actual / spent_estimated : 1.0;
       std::fprintf(stderr, "           took %s; about %s left (estimate x %.2f measured so far)\n",
-                   format_seconds(took).c_str(), format_seconds(left_estimated * scale).c_str(), scale);
+                   format_seconds(took).c_str(), format_seconds(std::max(0.0, left_estimated * scale)).c_str(), scale);
     }
   }
   outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
