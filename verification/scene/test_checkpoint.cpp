@@ -1,6 +1,6 @@
 // Checkpoint and resume (issue 6): a run killed after a checkpoint and
-// resumed ends bit for bit as the uninterrupted run; a checkpoint never
-// resumes into a different scene.
+// resumed ends bit for bit as the uninterrupted run, for the DEM run and the
+// coupled DEM-SPH runs; a checkpoint never resumes into a different scene.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -80,6 +80,100 @@ TEST(Checkpoint, RefusesACheckpointOfAnotherScene) {
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
     EXPECT_EQ(e.key(), "--resume") << e.what();
+  }
+}
+
+// Coupled DEM-SPH runs (models 2 and 3) on the small scene at Mn 1: strain
+// 0.6 in ~200 fluid steps (2 DEM sub-steps each), one row per fluid step.
+LoadedScene coupled_scene(const std::string& model, double mason = 1.0, int frames = 5) {
+  return load_scene(k_scene, {"scene.model=\"" + model + "\"", "drive.mason=" + std::to_string(mason),
+                              "drive.strain=0.6", "drive.warmup_strain=0.0", "output.every=1",
+                              "output.frames=" + std::to_string(frames)});
+}
+
+// The coupled run killed after a checkpoint and resumed ends as the
+// uninterrupted run: every summary value (wall time aside), the time series
+// and the frames byte for byte. The resumed file keeps a marker put into the
+// header of the killed run's time series: the run continued, it did not
+// start over.
+void check_coupled_resume_reproduces(const std::string& model, int frames) {
+  const auto base = std::filesystem::temp_directory_path() / ("mrf_ckpt_" + model + std::to_string(frames));
+  std::filesystem::remove_all(base);
+  RunOptions whole;
+  whole.out_dir = (base / "whole").string();
+  whole.quiet = true;
+  whole.checkpoint_seconds = 0;
+  const RunSummary a = run_scene(coupled_scene(model, 1.0, frames), whole);
+  const long fluid_steps = static_cast<long>(a.extra.at("fluid_steps"));
+  ASSERT_GE(fluid_steps, 32);
+
+  RunOptions cut = whole;
+  cut.out_dir = (base / "cut").string();
+  cut.checkpoint_every_rows = 25;
+  cut.stop_after_steps = fluid_steps * 2 / 3;
+  ASSERT_NE(cut.stop_after_steps % 25, 0) << "rows after the last checkpoint must be cut on resume";
+  EXPECT_THROW(run_scene(coupled_scene(model, 1.0, frames), cut), RunInterrupted);
+  ASSERT_TRUE(std::filesystem::exists(base / "cut/checkpoint.bin"));
+  EXPECT_FALSE(std::filesystem::exists(base / "cut/summary.json"));
+  std::string ts = slurp(base / "cut/timeseries.csv");
+  ASSERT_EQ(ts.substr(0, 6), "time_s");
+  ts[0] = 'T';
+  std::ofstream(base / "cut/timeseries.csv", std::ios::binary) << ts;
+
+  cut.stop_after_steps = 0;
+  cut.resume = true;
+  const RunSummary b = run_scene(coupled_scene(model, 1.0, frames), cut);
+  EXPECT_EQ(b.stress_total.mean, a.stress_total.mean);
+  EXPECT_EQ(b.stress_total.err, a.stress_total.err);
+  EXPECT_EQ(b.stress_virial.mean, a.stress_virial.mean);
+  EXPECT_EQ(b.stress_fluid, a.stress_fluid);
+  EXPECT_EQ(b.max_overlap_over_radius, a.max_overlap_over_radius);
+  EXPECT_EQ(b.neighbor_builds, a.neighbor_builds);
+  for (const auto& [key, value] : a.extra) {  // porosity range, momentum drift, wall reflections, ...
+    if (key == "seconds_per_strain") continue;
+    EXPECT_EQ(b.extra.at(key), value) << key;
+  }
+  ts = slurp(base / "cut/timeseries.csv");
+  EXPECT_EQ(ts[0], 'T') << "the resumed run rewrote the time series instead of continuing it";
+  ts[0] = 't';
+  EXPECT_EQ(ts, slurp(base / "whole/timeseries.csv"));
+  EXPECT_EQ(std::filesystem::exists(base / "cut/frames.xyz"), frames > 0);
+  EXPECT_EQ(slurp(base / "cut/frames.xyz"), slurp(base / "whole/frames.xyz"));
+  EXPECT_FALSE(std::filesystem::exists(base / "cut/checkpoint.bin"));  // removed once complete
+}
+
+TEST(Checkpoint, ResumedCoupledDiFeliceRunEqualsUninterruptedBitForBit) {
+  check_coupled_resume_reproduces("demsph_dd", 5);
+}
+TEST(Checkpoint, ResumedCoupledStokesRunWithoutFramesEqualsUninterruptedBitForBit) {
+  check_coupled_resume_reproduces("demsph_stokes", 0);
+}
+
+// A coupled checkpoint resumes neither into another Mason number nor into
+// another model, coupled or not.
+TEST(Checkpoint, RefusesACoupledCheckpointOfAnotherScene) {
+  const auto base = std::filesystem::temp_directory_path() / "mrf_ckpt_coupled_other";
+  std::filesystem::remove_all(base);
+  RunOptions cut;
+  cut.out_dir = base.string();
+  cut.quiet = true;
+  cut.checkpoint_every_rows = 3;
+  cut.stop_after_steps = 4;
+  EXPECT_THROW(run_scene(coupled_scene("demsph_dd", 1.0, 0), cut), RunInterrupted);
+  ASSERT_TRUE(std::filesystem::exists(base / "checkpoint.bin"));
+  cut.stop_after_steps = 0;
+  cut.resume = true;
+  const LoadedScene others[] = {coupled_scene("demsph_dd", 0.9, 0), coupled_scene("demsph_stokes", 1.0, 0),
+                                load_scene(k_scene, {"drive.mason=1.0", "drive.strain=0.6", "drive.warmup_strain=0.0",
+                                                     "output.every=1", "output.frames=0",
+                                                     "numerics.integrator=\"verlet_exp\""})};
+  for (const LoadedScene& other : others) {
+    try {
+      run_scene(other, cut);
+      ADD_FAILURE() << "expected InputError for " << to_string(other.config.model);
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.key(), "--resume") << e.what();
+    }
   }
 }
 

@@ -5,19 +5,44 @@
 
 namespace mrf {
 
+void save_dem_state(ArchiveWriter& out, const ShearCell& cell, const DemPairLists& lists) {
+  out.put(cell.free.x);
+  out.put(cell.free.v);
+  out.put(cell.free.f);
+  out.put(cell.walls.x);
+  out.put(lists.ff.start);
+  out.put(lists.ff.k);
+  out.put(lists.fw);
+  out.put(lists.x_ref);
+  out.put(lists.x_ref_fw);
+  out.put(static_cast<std::uint64_t>(lists.walls_ref));
+  out.put(lists.wall_travel);
+  out.put(lists.builds);
+}
+
+void load_dem_state(ArchiveReader& in, ShearCell& cell, DemPairLists& lists) {
+  const std::size_t n_free = cell.free.size(), n_wall = cell.walls.size();
+  in.get(cell.free.x);
+  in.get(cell.free.v);
+  in.get(cell.free.f);
+  in.get(cell.walls.x);
+  if (cell.free.x.size() != n_free || cell.free.v.size() != n_free || cell.free.f.size() != n_free ||
+      cell.walls.x.size() != n_wall)
+    throw NumericalError("checkpoint does not match the scene: particle counts differ");
+  in.get(lists.ff.start);
+  in.get(lists.ff.k);
+  in.get(lists.fw);
+  in.get(lists.x_ref);
+  in.get(lists.x_ref_fw);
+  std::uint64_t walls_ref = 0;
+  in.get(walls_ref);
+  lists.walls_ref = walls_ref;
+  in.get(lists.wall_travel);
+  in.get(lists.builds);
+}
+
 void DemModel::save(ArchiveWriter& out) const {
-  out.put(cell_.free.x);
-  out.put(cell_.free.v);
-  out.put(cell_.free.f);
-  out.put(cell_.walls.x);
-  out.put(lists_.ff.start);
-  out.put(lists_.ff.k);
-  out.put(lists_.fw);
-  out.put(lists_.x_ref);
-  out.put(lists_.x_ref_fw);
-  out.put(static_cast<std::uint64_t>(lists_.walls_ref));
-  out.put(lists_.wall_travel);
-  out.put(lists_.builds);
+  save_dem_state(out, cell_, lists_);
   out.put(sums_);
   out.put(time_);
   out.put(steps_);
@@ -27,24 +52,7 @@ void DemModel::save(ArchiveWriter& out) const {
 }
 
 void DemModel::load(ArchiveReader& in) {
-  const std::size_t n_free = cell_.free.size(), n_wall = cell_.walls.size();
-  in.get(cell_.free.x);
-  in.get(cell_.free.v);
-  in.get(cell_.free.f);
-  in.get(cell_.walls.x);
-  if (cell_.free.x.size() != n_free || cell_.free.v.size() != n_free || cell_.free.f.size() != n_free ||
-      cell_.walls.x.size() != n_wall)
-    throw NumericalError("checkpoint does not match the scene: particle counts differ");
-  in.get(lists_.ff.start);
-  in.get(lists_.ff.k);
-  in.get(lists_.fw);
-  in.get(lists_.x_ref);
-  in.get(lists_.x_ref_fw);
-  std::uint64_t walls_ref = 0;
-  in.get(walls_ref);
-  lists_.walls_ref = walls_ref;
-  in.get(lists_.wall_travel);
-  in.get(lists_.builds);
+  load_dem_state(in, cell_, lists_);
   in.get(sums_);
   in.get(time_);
   in.get(steps_);

@@ -72,56 +72,6 @@ void print_limits(const TimeStepChoice& t, const RunSummary& s, const DemParams&
                  s.reynolds_number);
 }
 
-// What the DEM run loop carries from one row to the next (checkpointed).
-struct LoopState {
-  long n = 0;                 // last completed step
-  double row_start = 0;       // time at which the current row began (s)
-  double strain_before = 0;   // strain reached by earlier sessions of this run
-  StressSeries se;
-  double max_overlap = 0;
-  long pair_evals = 0;
-  double elapsed_before = 0;  // wall seconds of earlier sessions of this run
-  std::uint64_t ts_bytes = 0, frames_bytes = 0;
-  void save(ArchiveWriter& a) const {
-    a.put(n);
-    a.put(row_start);
-    a.put(strain_before);
-    se.save(a);
-    a.put(max_overlap);
-    a.put(pair_evals);
-    a.put(elapsed_before);
-    a.put(ts_bytes);
-    a.put(frames_bytes);
-  }
-  void load(ArchiveReader& a) {
-    a.get(n);
-    a.get(row_start);
-    a.get(strain_before);
-    se.load(a);
-    a.get(max_overlap);
-    a.get(pair_evals);
-    a.get(elapsed_before);
-    a.get(ts_bytes);
-    a.get(frames_bytes);
-  }
-};
-
-// Every parameter of the scene, exactly: a checkpoint resumes only into the same run.
-std::string scene_fingerprint(const SceneConfig& c) {
-  std::string out;
-  char buf[64];
-  for (double v : {c.gap, c.ly, c.lz, c.radius, c.volume_fraction, c.density, c.magnetization, c.dipole_cutoff,
-                   c.wall_spacing, c.youngs_modulus, c.poisson_ratio, c.viscosity, c.fluid_density, c.sph_spacing,
-                   c.sound_speed, c.mason, c.shear_rate, c.strain, c.warmup_strain, c.dt.value_or(-1.0), c.skin,
-                   c.dt_safety}) {
-    std::snprintf(buf, sizeof buf, "%a;", v);
-    out += buf;
-  }
-  out += std::string(to_string(c.model)) + ";" + to_string(c.integrator) + ";" + std::to_string(c.seed) + ";" +
-         std::to_string(c.threads) + ";" + std::to_string(c.every) + ";" + std::to_string(c.frames);
-  return out;
-}
-
 }  // namespace
 
 // Everything summary.json states about a DEM run before it starts.
@@ -222,45 +172,14 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
   if (adaptive) model.set_stop_time(t_end);
   const long every = series_every(scene, s.steps);
   const long frame_every = c.frames > 0 ? std::max(1L, s.steps / c.frames) : 0;
-  const std::string checkpoint = opt.out_dir.empty() ? "" : opt.out_dir + "/checkpoint.bin";
-  const std::string fingerprint = scene_fingerprint(c);
+  RunFiles files(opt, c);
   LoopState st;
-  bool resumed = false;
-  if (opt.resume && !checkpoint.empty() && std::filesystem::exists(checkpoint)) {
-    ArchiveReader in(checkpoint);
-    std::string fp;
-    in.get(fp);
-    if (fp != fingerprint)
-      throw InputError("--resume", checkpoint, "",
-                       "the checkpoint was written by a run with different scene parameters; remove it or use "
-                       "another --out");
-    st.load(in);
-    model.load(in);
-    resumed = true;
-    if (!opt.quiet)
-      std::fprintf(stderr, "  resuming from %s at step %ld (strain %.4g)\n", checkpoint.c_str(), st.n,
-                   model.time() * c.shear_rate);
-  }
-  std::ofstream ts_out, frames_out;
-  if (!opt.out_dir.empty()) {
-    std::filesystem::create_directories(opt.out_dir);
-    if (resumed) {  // drop rows written after the checkpoint, then append
-      std::filesystem::resize_file(opt.out_dir + "/timeseries.csv", st.ts_bytes);
-      ts_out.open(opt.out_dir + "/timeseries.csv", std::ios::app);
-    } else {
-      ts_out.open(opt.out_dir + "/timeseries.csv");
-      write_series_header(ts_out);
-    }
-    ts_out.precision(10);
-    if (frame_every > 0) {
-      if (resumed) std::filesystem::resize_file(opt.out_dir + "/frames.xyz", st.frames_bytes);
-      frames_out.open(opt.out_dir + "/frames.xyz", resumed ? std::ios::app : std::ios::out);
-    }
-  }
+  if (files.open(st, frame_every > 0, [&](ArchiveReader& in) { model.load(in); }) && !opt.quiet)
+    std::fprintf(stderr, "  resuming from %s at step %ld (strain %.4g)\n", files.checkpoint().c_str(), st.n,
+                 model.time() * c.shear_rate);
   SeriesRow row;
   const auto t0 = std::chrono::steady_clock::now();
-  auto last_report = t0, last_checkpoint = t0;
-  long rows_since_checkpoint = 0;
+  auto last_report = t0;
   const double row_time = static_cast<double>(every) * ts.dt;
   long n = st.n;
   auto running = [&] { return adaptive ? model.time() < t_end * (1 - 1e-12) : n < s.steps; };
@@ -269,43 +188,19 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
     model.step();
     row.add(model.sums(), model.cell().box, s.stress_fluid, s.stress_fluid, adaptive ? model.dt() : 1.0);
     st.pair_evals += model.sums().pair_evaluations;
-    if (frame_every > 0 && n % frame_every == 0 && frames_out.is_open()) write_frame(frames_out, model.cell(), p.radius, model.time());
+    if (frame_every > 0 && n % frame_every == 0 && files.frames.is_open())
+      write_frame(files.frames, model.cell(), p.radius, model.time());
     const bool row_due = adaptive ? model.time() >= st.row_start + row_time * (1 - 1e-9) : n % every == 0;
     if (!row_due && running()) continue;
     const double strain = model.time() * c.shear_rate;
     st.max_overlap = std::max(st.max_overlap, row.max_overlap);
-    if (ts_out.is_open()) write_series_row(ts_out, model.time(), strain, row, p.radius);
+    if (files.series.is_open()) write_series_row(files.series, model.time(), strain, row, p.radius);
     if ((adaptive ? st.row_start * c.shear_rate : strain - row.n * ts.dt * c.shear_rate) >= c.warmup_strain)
       st.se.push(row);  // whole row after warm-up
     row = SeriesRow{};
     st.row_start = model.time();
+    files.end_row(st, n, strain, running(), [&](ArchiveWriter& out) { model.save(out); });
     const auto now = std::chrono::steady_clock::now();
-    ++rows_since_checkpoint;
-    const bool due = opt.checkpoint_every_rows > 0
-                         ? rows_since_checkpoint >= opt.checkpoint_every_rows
-                         : opt.checkpoint_seconds > 0 &&
-                               std::chrono::duration<double>(now - last_checkpoint).count() > opt.checkpoint_seconds;
-    if (!checkpoint.empty() && due && running()) {
-      LoopState snap = st;
-      snap.n = n;
-      snap.strain_before = strain;
-      snap.elapsed_before += std::chrono::duration<double>(now - t0).count();
-      ts_out.flush();
-      snap.ts_bytes = static_cast<std::uint64_t>(std::filesystem::file_size(opt.out_dir + "/timeseries.csv"));
-      if (frames_out.is_open()) {
-        frames_out.flush();
-        snap.frames_bytes = static_cast<std::uint64_t>(std::filesystem::file_size(opt.out_dir + "/frames.xyz"));
-      }
-      ArchiveWriter out(checkpoint + ".tmp");
-      out.put(fingerprint);
-      snap.save(out);
-      model.save(out);
-      out.close();
-      std::filesystem::rename(checkpoint + ".tmp", checkpoint);
-      last_checkpoint = now;
-      rows_since_checkpoint = 0;
-    }
-    if (opt.stop_after_steps > 0 && n >= opt.stop_after_steps) throw RunInterrupted(n);
     if (!opt.quiet && std::chrono::duration<double>(now - last_report).count() > 2.0) {
       last_report = now;
       const double el = std::chrono::duration<double>(now - t0).count();
@@ -332,10 +227,7 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
   s.neighbor_builds = model.lists().builds;
   s.particle_steps_per_second = static_cast<double>(s.n_particles * s.steps) / s.wall_seconds;
   s.pair_evaluations_per_second = static_cast<double>(st.pair_evals) / s.wall_seconds;
-  if (!opt.out_dir.empty()) {
-    write_file_atomic(opt.out_dir + "/summary.json", summary_json(s) + "\n");
-    std::filesystem::remove(checkpoint);  // the run is complete; summary.json is its record
-  }
+  files.finish(s);
   return s;
 }
 

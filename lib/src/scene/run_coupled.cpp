@@ -6,12 +6,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <sstream>
 
 #include "mrf/error.hpp"
-#include "mrf/io/atomic_file.hpp"
 #include "mrf/fluid/fluid_observables.hpp"
 #include "mrf/fluid/wcsph.hpp"
 #include "mrf/forces/drag.hpp"
@@ -135,67 +132,75 @@ RunSummary run_coupled_scene(const LoadedScene& scene, const RunOptions& opt) {
   const Vec3 p0 = model.momentum();
   const long every = series_every(scene, fluid_steps);
   const long frame_every = c.frames > 0 ? std::max(1L, fluid_steps / c.frames) : 0;
-  std::ofstream ts_out, frames_out;
-  if (!opt.out_dir.empty()) {
-    std::filesystem::create_directories(opt.out_dir);
-    ts_out.open(opt.out_dir + "/timeseries.csv");
-    ts_out.precision(10);
-    write_series_header(ts_out);
-    if (frame_every > 0) frames_out.open(opt.out_dir + "/frames.xyz");
-  }
-  StressSeries se;
+  // What the coupled loop carries besides the LoopState (checkpointed with the model).
+  struct {
+    double eps_min = 1, eps_max = 0, momentum_scale = 0;
+    long clamped_steps = 0;
+  } cst;
+  RunFiles files(opt, c);
+  LoopState st;
+  const bool resumed = files.open(st, frame_every > 0, [&](ArchiveReader& in) {
+    in.get(cst);
+    model.load(in);
+  });
+  if (resumed && !opt.quiet)
+    std::fprintf(stderr, "  resuming from %s at fluid step %ld (strain %.4g)\n", files.checkpoint().c_str(), st.n,
+                 model.time() * c.shear_rate);
   SeriesRow row;
-  double max_overlap = 0, eps_min = 1, eps_max = 0, momentum_scale = 0;
-  long pair_evals = 0, clamped_steps = 0;
   const auto t0 = std::chrono::steady_clock::now();
   auto last_report = t0;
-  for (long n = 1; n <= fluid_steps; ++n) {
+  for (long n = st.n + 1; n <= fluid_steps; ++n) {
     model.step();
     const CoupledStepSums& cs = model.sums();
     row.add(cs.dem, model.cell().box, cs.fluid_stress, cs.fluid_virial + cs.exchange_virial);
-    pair_evals += cs.dem.pair_evaluations;
-    eps_min = std::min(eps_min, cs.eps_min);
-    eps_max = std::max(eps_max, cs.eps_max);
-    clamped_steps += cs.eps_clamped > 0 ? 1 : 0;
-    if (frame_every > 0 && n % frame_every == 0 && frames_out)
-      write_frame(frames_out, model.cell(), p.radius, model.time());
+    st.pair_evals += cs.dem.pair_evaluations;
+    cst.eps_min = std::min(cst.eps_min, cs.eps_min);
+    cst.eps_max = std::max(cst.eps_max, cs.eps_max);
+    cst.clamped_steps += cs.eps_clamped > 0 ? 1 : 0;
+    if (frame_every > 0 && n % frame_every == 0 && files.frames.is_open())
+      write_frame(files.frames, model.cell(), p.radius, model.time());
     if (n % every != 0 && n != fluid_steps) continue;
     const double strain = model.time() * c.shear_rate;
-    max_overlap = std::max(max_overlap, row.max_overlap);
-    momentum_scale = std::max(momentum_scale, model.fluid().mass * static_cast<double>(model.fluid().fluid.size()) *
-                                                  std::abs(c.shear_rate) * 0.5 * model.cell().box.gap);
-    if (ts_out) write_series_row(ts_out, model.time(), strain, row, p.radius);
-    if (strain - row.n * ts.dt_fluid * c.shear_rate >= c.warmup_strain) se.push(row);
+    st.max_overlap = std::max(st.max_overlap, row.max_overlap);
+    cst.momentum_scale =
+        std::max(cst.momentum_scale, model.fluid().mass * static_cast<double>(model.fluid().fluid.size()) *
+                                         std::abs(c.shear_rate) * 0.5 * model.cell().box.gap);
+    if (files.series.is_open()) write_series_row(files.series, model.time(), strain, row, p.radius);
+    if (strain - row.n * ts.dt_fluid * c.shear_rate >= c.warmup_strain) st.se.push(row);
     row = SeriesRow{};
+    files.end_row(st, n, strain, n < fluid_steps, [&](ArchiveWriter& out) {
+      out.put(cst);
+      model.save(out);
+    });
     const auto now = std::chrono::steady_clock::now();
     if (!opt.quiet && std::chrono::duration<double>(now - last_report).count() > 2.0) {
       last_report = now;
       const double el = std::chrono::duration<double>(now - t0).count();
       std::fprintf(stderr, "\r  strain %.3f / %.3f  %.3g DEM steps/s  eps %.3f-%.3f  ETA %.0f s   ", strain,
-                   c.strain, static_cast<double>(model.dem_steps()) / el, cs.eps_min, cs.eps_max,
-                   el * static_cast<double>(fluid_steps - n) / static_cast<double>(n));
+                   c.strain, static_cast<double>((n - st.n) * ts.substeps) / el, cs.eps_min, cs.eps_max,
+                   el * static_cast<double>(fluid_steps - n) / static_cast<double>(n - st.n));
     }
   }
-  s.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  s.wall_seconds = st.elapsed_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (!opt.quiet)
     std::fprintf(stderr, "\r  done: %ld fluid steps x %d DEM sub-steps in %.1f s%30s\n", fluid_steps, ts.substeps,
                  s.wall_seconds, "");
-  se.finish(s);
+  st.se.finish(s);
   const Vec3 drift = model.momentum() - p0 - model.external_impulse();
-  s.max_overlap_over_radius = max_overlap / p.radius;
+  s.max_overlap_over_radius = st.max_overlap / p.radius;
   s.neighbor_builds = model.lists().builds;
   s.particle_steps_per_second = static_cast<double>(s.n_particles * s.steps) / s.wall_seconds;
-  s.pair_evaluations_per_second = static_cast<double>(pair_evals) / s.wall_seconds;
-  s.extra["stress_fluid_err"] = se.fluid().err;
-  s.extra["porosity_min"] = eps_min;
-  s.extra["porosity_max"] = eps_max;
+  s.pair_evaluations_per_second = static_cast<double>(st.pair_evals) / s.wall_seconds;
+  s.extra["stress_fluid_err"] = st.se.fluid().err;
+  s.extra["porosity_min"] = cst.eps_min;
+  s.extra["porosity_max"] = cst.eps_max;
   s.extra["porosity_design"] = eps_design;
-  s.extra["steps_with_clamped_porosity"] = static_cast<double>(clamped_steps);
+  s.extra["steps_with_clamped_porosity"] = static_cast<double>(cst.clamped_steps);
   s.extra["momentum_drift_N_s"] = drift.norm();
-  s.extra["momentum_drift_relative"] = momentum_scale > 0 ? drift.norm() / momentum_scale : 0.0;
+  s.extra["momentum_drift_relative"] = cst.momentum_scale > 0 ? drift.norm() / cst.momentum_scale : 0.0;
   s.extra["seconds_per_strain"] = s.wall_seconds / c.strain;
   s.extra["sph_wall_reflections"] = static_cast<double>(model.sums().wall_reflections);
-  if (!opt.out_dir.empty()) write_file_atomic(opt.out_dir + "/summary.json", summary_json(s) + "\n");
+  files.finish(s);
   return s;
 }
 

@@ -1,9 +1,12 @@
 #include "mrf/scene/run_series.hpp"
 
 #include <algorithm>
+#include <cstdio>
+#include <filesystem>
 #include <string>
 
 #include "mrf/error.hpp"
+#include "mrf/io/atomic_file.hpp"
 #include "mrf/observe/block_average.hpp"
 #include "mrf/observe/steady_state.hpp"
 #include "mrf/observe/stress.hpp"
@@ -104,6 +107,120 @@ long series_every(const LoadedScene& scene, long steps) {
                      "leaves only " + std::to_string(static_cast<long>(rows_after_warmup)) +
                          " time-series rows after the warm-up; block averaging needs at least 32");
   return every;
+}
+
+void LoopState::save(ArchiveWriter& a) const {
+  a.put(n);
+  a.put(row_start);
+  a.put(strain_before);
+  se.save(a);
+  a.put(max_overlap);
+  a.put(pair_evals);
+  a.put(elapsed_before);
+  a.put(ts_bytes);
+  a.put(frames_bytes);
+}
+
+void LoopState::load(ArchiveReader& a) {
+  a.get(n);
+  a.get(row_start);
+  a.get(strain_before);
+  se.load(a);
+  a.get(max_overlap);
+  a.get(pair_evals);
+  a.get(elapsed_before);
+  a.get(ts_bytes);
+  a.get(frames_bytes);
+}
+
+std::string scene_fingerprint(const SceneConfig& c) {
+  std::string out;
+  char buf[64];
+  for (double v : {c.gap, c.ly, c.lz, c.radius, c.volume_fraction, c.density, c.magnetization, c.dipole_cutoff,
+                   c.wall_spacing, c.youngs_modulus, c.poisson_ratio, c.viscosity, c.fluid_density, c.sph_spacing,
+                   c.sound_speed, c.mason, c.shear_rate, c.strain, c.warmup_strain, c.dt.value_or(-1.0), c.skin,
+                   c.dt_safety}) {
+    std::snprintf(buf, sizeof buf, "%a;", v);
+    out += buf;
+  }
+  out += std::string(to_string(c.model)) + ";" + to_string(c.integrator) + ";" + std::to_string(c.seed) + ";" +
+         std::to_string(c.threads) + ";" + std::to_string(c.every) + ";" + std::to_string(c.frames);
+  return out;
+}
+
+RunFiles::RunFiles(const RunOptions& opt, const SceneConfig& c)
+    : opt_(opt),
+      checkpoint_(opt.out_dir.empty() ? "" : opt.out_dir + "/checkpoint.bin"),
+      fingerprint_(scene_fingerprint(c)) {}
+
+bool RunFiles::open(LoopState& st, bool with_frames, const LoadModel& load_model) {
+  bool resumed = false;
+  if (opt_.resume && !checkpoint_.empty() && std::filesystem::exists(checkpoint_)) {
+    ArchiveReader in(checkpoint_);
+    std::string fp;
+    in.get(fp);
+    if (fp != fingerprint_)
+      throw InputError("--resume", checkpoint_, "",
+                       "the checkpoint was written by a run with different scene parameters; remove it or use "
+                       "another --out");
+    st.load(in);
+    load_model(in);
+    resumed = true;
+  }
+  if (!opt_.out_dir.empty()) {
+    std::filesystem::create_directories(opt_.out_dir);
+    const std::string ts = opt_.out_dir + "/timeseries.csv", fr = opt_.out_dir + "/frames.xyz";
+    if (resumed) {  // drop rows written after the checkpoint, then append
+      std::filesystem::resize_file(ts, st.ts_bytes);
+      series.open(ts, std::ios::app);
+    } else {
+      series.open(ts);
+      write_series_header(series);
+    }
+    series.precision(10);
+    if (with_frames) {
+      if (resumed) std::filesystem::resize_file(fr, st.frames_bytes);
+      frames.open(fr, resumed ? std::ios::app : std::ios::out);
+    }
+  }
+  start_ = last_checkpoint_ = std::chrono::steady_clock::now();
+  return resumed;
+}
+
+void RunFiles::end_row(const LoopState& st, long n, double strain, bool more, const SaveModel& save_model) {
+  const auto now = std::chrono::steady_clock::now();
+  ++rows_since_checkpoint_;
+  const bool due = opt_.checkpoint_every_rows > 0
+                       ? rows_since_checkpoint_ >= opt_.checkpoint_every_rows
+                       : opt_.checkpoint_seconds > 0 &&
+                             std::chrono::duration<double>(now - last_checkpoint_).count() > opt_.checkpoint_seconds;
+  if (!checkpoint_.empty() && due && more) {
+    LoopState snap = st;
+    snap.n = n;
+    snap.strain_before = strain;
+    snap.elapsed_before += std::chrono::duration<double>(now - start_).count();
+    series.flush();
+    snap.ts_bytes = static_cast<std::uint64_t>(std::filesystem::file_size(opt_.out_dir + "/timeseries.csv"));
+    if (frames.is_open()) {
+      frames.flush();
+      snap.frames_bytes = static_cast<std::uint64_t>(std::filesystem::file_size(opt_.out_dir + "/frames.xyz"));
+    }
+    ArchiveWriter out(checkpoint_ + ".tmp");
+    out.put(fingerprint_);
+    snap.save(out);
+    save_model(out);
+    out.close();
+    std::filesystem::rename(checkpoint_ + ".tmp", checkpoint_);
+    last_checkpoint_ = now;
+    rows_since_checkpoint_ = 0;
+  }
+  if (opt_.stop_after_steps > 0 && n >= opt_.stop_after_steps) throw RunInterrupted(n);
+}
+
+void RunFiles::finish(const RunSummary& s) {
+  if (opt_.out_dir.empty()) return;
+  write_file_atomic(opt_.out_dir + "/summary.json", summary_json(s) + "\n");
+  std::filesystem::remove(checkpoint_);  // the run is complete; summary.json is its record
 }
 
 }  // namespace mrf

@@ -26,6 +26,9 @@ class ArchiveWriter {
     static_assert(std::is_trivially_copyable_v<T>);
     out_.write(reinterpret_cast<const char*>(&v), sizeof(T));
   }
+  void put(const Vec3& v) {
+    for (int k = 0; k < 3; ++k) put(v[k]);
+  }
   template <class T>
   void put(const std::vector<T>& v) {
     static_assert(std::is_trivially_copy_constructible_v<T> || std::is_same_v<T, Vec3>);
@@ -57,6 +60,9 @@ class ArchiveReader {
     static_assert(std::is_trivially_copyable_v<T>);
     in_.read(reinterpret_cast<char*>(&v), sizeof(T));
     check();
+  }
+  void get(Vec3& v) {
+    for (int k = 0; k < 3; ++k) get(v[k]);
   }
   template <class T>
   void get(std::vector<T>& v) {

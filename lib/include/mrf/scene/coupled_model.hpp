@@ -28,6 +28,7 @@
 #include "mrf/coupling/exchange.hpp"
 #include "mrf/fluid/fluid_cell.hpp"
 #include "mrf/integrate/coupled_steps.hpp"
+#include "mrf/io/archive.hpp"
 #include "mrf/scene/dem_forces.hpp"
 #include "mrf/scene/shear_cell.hpp"
 
@@ -85,6 +86,16 @@ class CoupledModel {
   const std::vector<Vec3>& buoyancy() const { return buoyancy_; }
   // Constant extra force on every free particle (N), e.g. for settling tests.
   void set_body_force(const Vec3& f) { body_force_ = f; }
+
+  // Checkpoint: the state carried from one fluid step to the next (DEM
+  // particles, walls and pair lists, SPH particles, counters, clock), so
+  // that a restored model continues bit for bit (scene/coupled_checkpoint.cpp;
+  // what is not saved is listed there). load() expects a model built from
+  // the same scene; until the next step() the accessors of the last step's
+  // coupling fields (coupling(), buoyancy(), ...) and sums() other than
+  // wall_reflections and the porosity range are not restored.
+  void save(ArchiveWriter& out) const;
+  void load(ArchiveReader& in);
 
  private:
   void update_coupling_pairs();

@@ -101,4 +101,11 @@ class DemModel {
   std::vector<Vec3> x0_, b_, fc_, walls0_;
 };
 
+// The DEM part of a checkpoint, shared by DemModel and CoupledModel: free
+// particles (x, v, f), wall positions and the Verlet lists as built (their
+// reference positions decide the next rebuild, their order the round-off).
+// load_dem_state throws NumericalError when the particle counts differ.
+void save_dem_state(ArchiveWriter& out, const ShearCell& cell, const DemPairLists& lists);
+void load_dem_state(ArchiveReader& in, ShearCell& cell, DemPairLists& lists);
+
 }  // namespace mrf

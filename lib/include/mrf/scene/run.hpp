@@ -27,7 +27,7 @@ TimeStepChoice choose_time_step(const LoadedScene& scene, const DemParams& p);
 struct RunOptions {
   std::string out_dir;  // empty: write nothing
   bool quiet = false;   // no progress or start-up table on stderr
-  // Checkpoints (DEM runs): out_dir/checkpoint.bin, written atomically at a
+  // Checkpoints (DEM and coupled runs): out_dir/checkpoint.bin, written atomically at a
   // time-series row boundary every `checkpoint_seconds` of wall time (or every
   // `checkpoint_every_rows` rows when > 0), removed when the run completes.
   // With `resume` a run continues from it and ends bit for bit as an
@@ -35,7 +35,8 @@ struct RunOptions {
   bool resume = false;
   double checkpoint_seconds = 60;
   long checkpoint_every_rows = 0;
-  long stop_after_steps = 0;  // tests: throw RunInterrupted after this step, as a kill would stop the run
+  // Tests: throw RunInterrupted after this step (fluid step of a coupled run), as a kill would stop the run.
+  long stop_after_steps = 0;
 };
 
 // Thrown by run_scene when RunOptions::stop_after_steps is reached.

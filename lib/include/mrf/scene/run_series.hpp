@@ -1,8 +1,14 @@
 // Pieces of a run loop shared by the DEM and the coupled runs: time-series
 // rows (sums over the steps between two rows), the block-averaged stress
-// series of the steady part, the timeseries.csv format and particle frames.
+// series of the steady part, the timeseries.csv format, particle frames and
+// the output files with checkpoints.
 #pragma once
+#include <chrono>
+#include <cstdint>
+#include <fstream>
+#include <functional>
 #include <ostream>
+#include <string>
 #include <vector>
 
 #include "mrf/io/archive.hpp"
@@ -52,5 +58,56 @@ void write_frame(std::ostream& out, const ShearCell& cell, double radius, double
 // Steps between rows (output.every or ~2000 rows) and the check that at
 // least 32 rows follow the warm-up; throws InputError on output.every.
 long series_every(const LoadedScene& scene, long steps);
+
+// What a run loop carries from one row to the next (checkpointed).
+struct LoopState {
+  long n = 0;                 // last completed step
+  double row_start = 0;       // time at which the current row began (s)
+  double strain_before = 0;   // strain reached by earlier sessions of this run
+  StressSeries se;
+  double max_overlap = 0;
+  long pair_evals = 0;
+  double elapsed_before = 0;  // wall seconds of earlier sessions of this run
+  std::uint64_t ts_bytes = 0, frames_bytes = 0;  // lengths of timeseries.csv and frames.xyz
+  void save(ArchiveWriter& a) const;
+  void load(ArchiveReader& a);
+};
+
+// Every parameter of the scene, exactly: a checkpoint resumes only into the same run.
+std::string scene_fingerprint(const SceneConfig& c);
+
+// The files of a run loop in RunOptions::out_dir (none when it is empty):
+// timeseries.csv, frames.xyz, checkpoint.bin and summary.json. A checkpoint
+// holds the scene fingerprint, the LoopState and what the loop saves of its
+// model; it is written atomically (temporary file + rename) at a row
+// boundary every checkpoint_seconds of wall time (or checkpoint_every_rows
+// rows) and removed when the run completes.
+class RunFiles {
+ public:
+  using SaveModel = std::function<void(ArchiveWriter&)>;
+  using LoadModel = std::function<void(ArchiveReader&)>;
+  RunFiles(const RunOptions& opt, const SceneConfig& c);
+  // With RunOptions::resume and a checkpoint in out_dir: checks its
+  // fingerprint (InputError on "--resume" if another scene wrote it), loads
+  // `st`, then the model with `load_model`. Opens timeseries.csv and, with
+  // `with_frames`, frames.xyz: new, or cut back to the checkpoint and
+  // appended to. Returns whether the run resumed.
+  bool open(LoopState& st, bool with_frames, const LoadModel& load_model);
+  // At a row boundary after step n, at `strain`: writes a checkpoint of `st`
+  // at step n when one is due and the run goes on (`more`), then throws
+  // RunInterrupted when RunOptions::stop_after_steps is reached.
+  void end_row(const LoopState& st, long n, double strain, bool more, const SaveModel& save_model);
+  // The run is complete: summary.json (atomically), then the checkpoint is removed.
+  void finish(const RunSummary& s);
+  const std::string& checkpoint() const { return checkpoint_; }
+
+  std::ofstream series, frames;  // open when out_dir is set (frames when asked for)
+
+ private:
+  RunOptions opt_;
+  std::string checkpoint_, fingerprint_;
+  std::chrono::steady_clock::time_point start_, last_checkpoint_;
+  long rows_since_checkpoint_ = 0;
+};
 
 }  // namespace mrf
