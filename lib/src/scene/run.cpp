@@ -77,14 +77,9 @@ void print_limits(const TimeStepChoice& t, const RunSummary& s, const DemParams&
 // Everything summary.json states about a DEM run before it starts.
 static RunSummary dem_summary_header(const SceneConfig& c, const DemParams& p, const TimeStepChoice& ts,
                                      const ShearCell& cell) {
-  RunSummary s;
-  s.model = to_string(c.model);
+  RunSummary s = scene_summary(c);
   s.integrator = to_string(ts.scheme);
   s.binding_limit = binding(ts.limits).name;
-  s.mason = c.mason;
-  s.shear_rate = c.shear_rate;
-  s.strain = c.strain;
-  s.warmup_strain = c.warmup_strain;
   s.dt = ts.dt;
   s.steps = static_cast<long>(std::ceil(c.strain / (c.shear_rate * ts.dt)));
   s.n_particles = static_cast<long>(cell.free.size());
@@ -92,12 +87,6 @@ static RunSummary dem_summary_header(const SceneConfig& c, const DemParams& p, c
   s.stokes_number = stokes_number(p);
   s.reynolds_number = particle_reynolds(c);
   s.stress_fluid = imposed_fluid_stress(c.viscosity, c.shear_rate);
-  s.youngs_modulus = c.youngs_modulus;
-  s.density = c.density;
-  s.magnetization = c.magnetization;
-  s.volume_fraction = c.volume_fraction;
-  s.seed = c.seed;
-  s.threads = omp_get_max_threads();
   return s;
 }
 
@@ -107,13 +96,8 @@ static RunSummary dem_summary_header(const SceneConfig& c, const DemParams& p, c
 static RunSummary run_fluid_only(const LoadedScene& scene, const RunOptions& opt) {
   const SceneConfig& c = scene.config;
   const CouetteSphResult r = run_couette_sph(c, c.strain / c.shear_rate);
-  RunSummary s;
-  s.model = to_string(c.model);
+  RunSummary s = scene_summary(c);
   s.integrator = r.implicit_viscosity ? "sph_implicit_viscosity" : "sph_explicit";
-  s.mason = c.mason;
-  s.shear_rate = c.shear_rate;
-  s.strain = c.strain;
-  s.warmup_strain = c.warmup_strain;
   s.dt = r.dt;
   s.steps = r.steps;
   s.n_fluid = static_cast<long>(r.n_fluid);
@@ -121,8 +105,6 @@ static RunSummary run_fluid_only(const LoadedScene& scene, const RunOptions& opt
   s.stress_fluid = r.shear_stress;
   s.reynolds_number = r.reynolds;
   s.wall_seconds = r.wall_seconds;
-  s.seed = c.seed;
-  s.threads = omp_get_max_threads();
   s.extra = {{"stress_startup_series", r.analytic_stress},
              {"stress_steady_eta_gdot", r.steady_stress},
              {"profile_error_l2", r.profile_error},

@@ -95,14 +95,9 @@ RunSummary run_coupled_scene(const LoadedScene& scene, const RunOptions& opt) {
   const CoupledTimeStep ts = choose_coupled_time_step(scene, p, fluid, eps_design);
   const long fluid_steps = static_cast<long>(std::ceil(c.strain / (c.shear_rate * ts.dt_fluid)));
 
-  RunSummary s;
-  s.model = to_string(c.model);
+  RunSummary s = scene_summary(c);
   s.integrator = "sph_explicit+dem_verlet_exp_parcel";
   s.binding_limit = binding(ts.fluid_limits).name;
-  s.mason = c.mason;
-  s.shear_rate = c.shear_rate;
-  s.strain = c.strain;
-  s.warmup_strain = c.warmup_strain;
   s.dt = ts.dt_fluid / ts.substeps;
   s.steps = fluid_steps * ts.substeps;
   s.n_particles = static_cast<long>(cell.free.size());
@@ -110,12 +105,6 @@ RunSummary run_coupled_scene(const LoadedScene& scene, const RunOptions& opt) {
   s.n_fluid = static_cast<long>(fluid.fluid.size());
   s.stokes_number = stokes_number(p);
   s.reynolds_number = particle_reynolds(c);
-  s.youngs_modulus = c.youngs_modulus;
-  s.density = c.density;
-  s.magnetization = c.magnetization;
-  s.volume_fraction = c.volume_fraction;
-  s.seed = c.seed;
-  s.threads = omp_get_max_threads();
   s.extra = {{"dt_fluid", ts.dt_fluid},
              {"substeps", ts.substeps},
              {"fluid_steps", static_cast<double>(fluid_steps)},

@@ -1,5 +1,7 @@
 #include "mrf/scene/run_series.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -74,6 +76,22 @@ void StressSeries::finish(RunSummary& s) const {
   // discard as transient (0 = steady from the end of the warm-up)
   s.extra["steady_mser_discard_fraction"] =
       total_.empty() ? 0.0 : static_cast<double>(mser_truncation(total_)) / static_cast<double>(total_.size());
+}
+
+RunSummary scene_summary(const SceneConfig& c) {
+  RunSummary s;
+  s.model = to_string(c.model);
+  s.mason = c.mason;
+  s.shear_rate = c.shear_rate;
+  s.strain = c.strain;
+  s.warmup_strain = c.warmup_strain;
+  s.youngs_modulus = c.youngs_modulus;
+  s.density = c.density;
+  s.magnetization = c.magnetization;
+  s.volume_fraction = c.volume_fraction;
+  s.seed = c.seed;
+  s.threads = omp_get_max_threads();
+  return s;
 }
 
 void write_series_header(std::ostream& out) {

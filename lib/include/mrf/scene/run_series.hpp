@@ -49,6 +49,10 @@ class StressSeries {
   std::vector<double> total_, particles_, fluid_, virial_, mag_, con_, diff_, vir_fluid_, vir_total_;
 };
 
+// The fields of summary.json that come from the scene alone (model, Mn,
+// shear rate, strains, material, seed) and the thread count.
+RunSummary scene_summary(const SceneConfig& c);
+
 void write_series_header(std::ostream& out);
 void write_series_row(std::ostream& out, double time, double strain, const SeriesRow& row, double radius);
 
