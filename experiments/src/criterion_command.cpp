@@ -66,11 +66,11 @@ int run_directory(const std::string& dir, const Thresholds* t) {
   const double share = j.at("stress_fluid").get<double>() / total;
   if (j.contains("stress_virial_total")) {
     const double m = 1.0 - total / j["stress_virial_total"].get<double>();
-    const double st = j.at("stokes_number").get<double>();
-    std::printf("%s: self-consistency mismatch m = 1 - tau_wall/tau_volume = %.3f, St = %.3g -> model 1 %s within "
-                "10 %%, %s within 20 %% of the two-way model (|m| < level and St < %.2g)\n",
-                dir.c_str(), m, st, mrf::consistency_adequate(m, st, 0.1) ? "ADEQUATE" : "NOT adequate",
-                mrf::consistency_adequate(m, st, 0.2) ? "ADEQUATE" : "NOT adequate", mrf::k_criterion_max_stokes);
+    const double re = j.at("reynolds_number").get<double>();
+    std::printf("%s: self-consistency mismatch m = 1 - tau_wall/tau_volume = %.3f, Re_p = %.3g -> model 1 %s within "
+                "10 %%, %s within 20 %% of the two-way model (|m| < level and Re_p < %.2g)\n",
+                dir.c_str(), m, re, mrf::consistency_adequate(m, re, 0.1) ? "ADEQUATE" : "NOT adequate",
+                mrf::consistency_adequate(m, re, 0.2) ? "ADEQUATE" : "NOT adequate", mrf::k_criterion_max_reynolds);
   }
   if (!t) {
     std::printf("%s: hydrodynamic share s = %.3g (give --thresholds FILE for the share verdict)\n", dir.c_str(), share);
@@ -128,10 +128,10 @@ int criterion_command(const std::string& path, const std::string& thresholds_pat
       ordered_json r{{"mason", d.mason},    {"deviation", d.value},
                      {"err", d.err},        {"share", d.share},
                      {"mismatch", d.mismatch}, {"volume_deviation", d.volume_value},
-                     {"stokes", d.stokes}};
+                     {"stokes", d.stokes},  {"reynolds", d.reynolds}};
       if (std::string(m) == "dem_stokes")
         for (double level : {0.1, 0.2}) {  // the self-consistency verdict against the actual deviation
-          const bool predicted = mrf::consistency_adequate(d.mismatch, d.stokes, level);
+          const bool predicted = mrf::consistency_adequate(d.mismatch, d.reynolds, level);
           const bool actual = std::abs(d.value) < level;
           r[level == 0.1 ? "consistency_hit_10" : "consistency_hit_20"] = predicted == actual;
           hits += predicted == actual;
@@ -139,14 +139,14 @@ int criterion_command(const std::string& path, const std::string& thresholds_pat
         }
       rows.push_back(r);
       std::printf("%-14s Mn = %-6.3g tau/tau_3 - 1 = %+.3f +- %.3f, share s = %.3f, mismatch m = %+.3f, St = %.2g, "
-                  "volume stress/tau_3 - 1 = %+.3f\n",
-                  m, d.mason, d.value, d.err, d.share, d.mismatch, d.stokes, d.volume_value);
+                  "Re_p = %.2g, volume stress/tau_3 - 1 = %+.3f\n",
+                  m, d.mason, d.value, d.err, d.share, d.mismatch, d.stokes, d.reynolds, d.volume_value);
     }
     out["deviation_from_demsph_dd"][m]["points"] = rows;
     if (tested) {
       out["deviation_from_demsph_dd"][m]["consistency_hit_rate"] = static_cast<double>(hits) / tested;
-      std::printf("%-14s self-consistency criterion (|m| < level and St < %.2g <=> |tau_1/tau_3 - 1| < level): %d of "
-                  "%d verdicts right\n", m, mrf::k_criterion_max_stokes, hits, tested);
+      std::printf("%-14s self-consistency criterion (|m| < level and Re_p < %.2g <=> |tau_1/tau_3 - 1| < level): %d "
+                  "of %d verdicts right\n", m, mrf::k_criterion_max_reynolds, hits, tested);
     }
     for (double level : {0.1, 0.2}) {
       const auto c = mrf::first_crossing(dev, level);

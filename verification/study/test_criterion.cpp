@@ -57,21 +57,21 @@ TEST(Criterion, CrossingIsInterpolatedInLogMason) {
   EXPECT_TRUE(apply_criterion(0.21, 0.2, 0.4).adequate_20);
 }
 
-TEST(Criterion, ConsistencyVerdictNeedsSmallMismatchAndSmallStokes) {
+TEST(Criterion, ConsistencyVerdictNeedsSmallMismatchAndSmallReynolds) {
   EXPECT_TRUE(consistency_adequate(0.05, 0.01, 0.1));
   EXPECT_TRUE(consistency_adequate(-0.05, 0.01, 0.1));
   EXPECT_FALSE(consistency_adequate(0.15, 0.01, 0.1));
   EXPECT_TRUE(consistency_adequate(0.15, 0.01, 0.2));
-  EXPECT_FALSE(consistency_adequate(0.05, 0.3, 0.1));  // particle inertia: the two-way fluid stress differs
+  EXPECT_FALSE(consistency_adequate(0.05, 0.2, 0.1));  // fluid inertia: the two-way fluid stress differs
 }
 
 TEST(Criterion, ReadsSweepCsvSkippingFailedPoints) {
   const auto p = std::filesystem::temp_directory_path() / "mrf_test_sweep.csv";
   std::ofstream(p) << "model,mason,seed,status,shear_rate,stress_total,stress_total_err,stress_fluid,"
-                      "stress_virial_total,stokes_number,magnetization,volume_fraction,dir\n"
-                      "dem_stokes,0.01,1,ok,100,50,1,10,80,0.003,1000000,0.3,a\n"
-                      "dem_stokes,0.01,2,failed,,,,,,,,,b\n"
-                      "demsph_dd,0.01,1,ok,100,60,2,20,60,0.003,1000000,0.3,c\n";
+                      "stress_virial_total,stokes_number,reynolds_number,magnetization,volume_fraction,dir\n"
+                      "dem_stokes,0.01,1,ok,100,50,1,10,80,0.003,0.002,1000000,0.3,a\n"
+                      "dem_stokes,0.01,2,failed,,,,,,,,,,b\n"
+                      "demsph_dd,0.01,1,ok,100,60,2,20,60,0.003,0.002,1000000,0.3,c\n";
   const SweepTable t = read_sweep_csv(p.string());
   ASSERT_EQ(t.samples.at("dem_stokes").size(), 1u);
   ASSERT_EQ(t.samples.at("demsph_dd").size(), 1u);
@@ -80,6 +80,7 @@ TEST(Criterion, ReadsSweepCsvSkippingFailedPoints) {
   EXPECT_DOUBLE_EQ(t.samples.at("demsph_dd")[0].stress_fluid, 20);
   EXPECT_DOUBLE_EQ(t.samples.at("dem_stokes")[0].stress_volume, 80);
   EXPECT_DOUBLE_EQ(t.samples.at("dem_stokes")[0].stokes, 0.003);
+  EXPECT_DOUBLE_EQ(t.samples.at("dem_stokes")[0].reynolds, 0.002);
   const auto d = deviation(seed_average(t.samples.at("dem_stokes")), seed_average(t.samples.at("demsph_dd")));
   ASSERT_EQ(d.size(), 1u);
   EXPECT_NEAR(d[0].mismatch, 1.0 - 50.0 / 80.0, 1e-15);

@@ -46,6 +46,8 @@ SweepTable read_sweep_csv(const std::string& path) {
     s.err = std::stod(c[col["stress_total_err"]]);
     s.stress_fluid = std::stod(c[col["stress_fluid"]]);
     if (col.count("stokes_number") && !c[col["stokes_number"]].empty()) s.stokes = std::stod(c[col["stokes_number"]]);
+    if (col.count("reynolds_number") && !c[col["reynolds_number"]].empty())
+      s.reynolds = std::stod(c[col["reynolds_number"]]);
     if (col.count("stress_virial_total") && !c[col["stress_virial_total"]].empty())
       s.stress_volume = std::stod(c[col["stress_virial_total"]]);
     t.magnetization = std::stod(c[col["magnetization"]]);
@@ -72,6 +74,7 @@ std::vector<Deviation> deviation(const std::vector<FlowPoint>& model, const std:
         d.mismatch = m.stress_volume != 0 ? 1.0 - m.stress / m.stress_volume : 0.0;
         d.volume_value = m.stress_volume != 0 ? m.stress_volume / r.stress - 1.0 : 0.0;
         d.stokes = m.stokes;
+        d.reynolds = m.reynolds;
         out.push_back(d);
       }
   return out;
@@ -98,8 +101,8 @@ Crossing first_crossing(const std::vector<Deviation>& d, double level) {
   return c;
 }
 
-bool consistency_adequate(double mismatch, double stokes, double level) {
-  return std::abs(mismatch) < level && stokes < k_criterion_max_stokes;
+bool consistency_adequate(double mismatch, double reynolds, double level) {
+  return std::abs(mismatch) < level && reynolds < k_criterion_max_reynolds;
 }
 
 CriterionVerdict apply_criterion(double share, double s10, double s20) {

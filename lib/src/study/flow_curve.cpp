@@ -27,6 +27,7 @@ std::vector<FlowPoint> seed_average(const std::vector<StressSample>& samples) {
       p.stress_fluid += s->stress_fluid / n;
       p.stress_volume += s->stress_volume / n;
       p.stokes = s->stokes;
+      p.reynolds = s->reynolds;
       sum_err2 += s->err * s->err;
     }
     double ss = 0;

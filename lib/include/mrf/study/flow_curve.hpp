@@ -23,6 +23,7 @@ struct StressSample {
   double stress_fluid = 0;     // Pa, the hydrodynamic part (eta gdot for model 1)
   double stress_volume = 0;    // Pa, volume-side total: pair virial + fluid (stress_virial_total)
   double stokes = 0;           // Stokes number tau_p gdot of the run
+  double reynolds = 0;         // particle Reynolds number rho_f gdot R^2 / eta of the run
 };
 
 // Seed average at one Mason number.
@@ -35,6 +36,7 @@ struct FlowPoint {
   double stress_fluid = 0;  // mean hydrodynamic part (Pa)
   double stress_volume = 0; // mean volume-side total (Pa)
   double stokes = 0;        // Stokes number (the same for every seed)
+  double reynolds = 0;      // particle Reynolds number (the same for every seed)
   int seeds = 0;
 };
 
