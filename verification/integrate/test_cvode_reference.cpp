@@ -6,6 +6,8 @@
 // inertialess gamma dx/dt = F (its own limit: the two models differ by O(St)).
 #include <cvode/cvode.h>
 #include <gtest/gtest.h>
+
+#include "support/cvode_handles.hpp"
 #include <nvector/nvector_serial.h>
 #include <sunlinsol/sunlinsol_dense.h>
 #include <sunmatrix/sunmatrix_dense.h>
@@ -68,21 +70,7 @@ int contact_root(sunrealtype, N_Vector y, sunrealtype* g, void* user) {
 
 Reference cvode_reference(const PairProblem& pb, bool inertial, const std::vector<double>& t_out,
                           double rtol = k_rtol) {
-  struct Handles {
-    SUNContext ctx = nullptr;
-    N_Vector y = nullptr, atol = nullptr;
-    SUNMatrix a = nullptr;
-    SUNLinearSolver ls = nullptr;
-    void* mem = nullptr;
-    ~Handles() {
-      CVodeFree(&mem);
-      SUNLinSolFree(ls);
-      SUNMatDestroy(a);
-      N_VDestroy(atol);
-      N_VDestroy(y);
-      SUNContext_Free(&ctx);
-    }
-  } h;
+  test::CvodeHandles h;
   const DemParams& p = pb.params;
   const sunindextype n = inertial ? 12 : 6;
   const Vec3 centre = 0.5 * (pb.x0[0] + pb.x0[1]);

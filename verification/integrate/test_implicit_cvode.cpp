@@ -13,6 +13,8 @@
 // bounded by the static Hertz overlap under the chain load.
 #include <cvode/cvode.h>
 #include <gtest/gtest.h>
+
+#include "support/cvode_handles.hpp"
 #include <nvector/nvector_serial.h>
 #include <sunlinsol/sunlinsol_dense.h>
 #include <sunmatrix/sunmatrix_dense.h>
@@ -84,20 +86,7 @@ int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user) {
 
 // CVODE BDF with a dense direct solver (difference-quotient Jacobian).
 std::vector<Positions> cvode_reference(const Problem& pb, const std::vector<double>& t_out, double rtol) {
-  struct Handles {
-    SUNContext ctx = nullptr;
-    N_Vector y = nullptr;
-    SUNMatrix a = nullptr;
-    SUNLinearSolver ls = nullptr;
-    void* mem = nullptr;
-    ~Handles() {
-      CVodeFree(&mem);
-      SUNLinSolFree(ls);
-      SUNMatDestroy(a);
-      N_VDestroy(y);
-      SUNContext_Free(&ctx);
-    }
-  } h;
+  test::CvodeHandles h;
   const auto n = static_cast<sunindextype>(3 * pb.x0.size());
   check(SUNContext_Create(nullptr, &h.ctx), "SUNContext_Create");
   h.y = N_VNew_Serial(n, h.ctx);

@@ -11,6 +11,8 @@
 // both over strain 0.3 .. 1 equal within the error bars. Slow (~1 min).
 #include <cvode/cvode.h>
 #include <gtest/gtest.h>
+
+#include "support/cvode_handles.hpp"
 #include <nvector/nvector_serial.h>
 #include <sunlinsol/sunlinsol_spgmr.h>
 
@@ -155,18 +157,7 @@ Result run_cvode(const LoadedScene& s, double strain, double warmup, double atol
   o.cell.free.v.assign(o.cell.free.size(), Vec3::Zero());
   o.cell.free.f.assign(o.cell.free.size(), Vec3::Zero());
   o.lists = make_pair_lists(std::max(p.dipole_cutoff, 2 * p.radius), 2 * p.radius, p.skin);
-  struct Handles {
-    SUNContext ctx = nullptr;
-    N_Vector y = nullptr;
-    SUNLinearSolver ls = nullptr;
-    void* mem = nullptr;
-    ~Handles() {
-      CVodeFree(&mem);
-      SUNLinSolFree(ls);
-      N_VDestroy(y);
-      SUNContext_Free(&ctx);
-    }
-  } h;
+  test::CvodeHandles h;
   const auto n = static_cast<sunindextype>(3 * o.cell.free.size());
   check(SUNContext_Create(nullptr, &h.ctx), "SUNContext_Create");
   h.y = N_VNew_Serial(n, h.ctx);

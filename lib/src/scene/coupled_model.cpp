@@ -6,6 +6,7 @@
 
 #include "mrf/coupling/drag_laws.hpp"
 #include "mrf/error.hpp"
+#include "mrf/fluid/couette_sph.hpp"
 #include "mrf/fluid/fluid_observables.hpp"
 #include "mrf/fluid/kernel.hpp"
 #include "mrf/fluid/viscosity.hpp"
@@ -51,13 +52,7 @@ double fluid_pair_virial_xz(const FluidCell& c) {
 }  // namespace
 
 FluidCell build_coupled_fluid(const SceneConfig& c, const ShearCell& cell) {
-  FluidParams fp;
-  fp.viscosity = c.viscosity;
-  fp.density = c.fluid_density;
-  fp.spacing = c.sph_spacing;
-  fp.sound_speed = c.sound_speed;
-  fp.shear_rate = c.shear_rate;
-  FluidCell f = build_fluid_cell(cell.box, fp);
+  FluidCell f = build_fluid_cell(cell.box, fluid_params_from_scene(c));
   const double phi = static_cast<double>(cell.free.size()) * sphere_volume(c.radius) / cell.box.volume();
   f.mass *= 1.0 - phi;
   for (std::size_t a = 0; a < f.fluid.size(); ++a) f.fluid.v[a] = Vec3(0.0, 0.0, c.shear_rate * f.fluid.x[a].x());
