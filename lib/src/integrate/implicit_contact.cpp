@@ -34,6 +34,28 @@ void contact_candidates(const DemPairLists& lists, const std::vector<Vec3>& x, c
     if (box.min_image(x[i] - walls.x[k]).squaredNorm() < reach2) out.push_back({i, k, true});
 }
 
+void near_pairs(const DemPairLists& lists, const Box& box, double reach, std::vector<ContactPair>& out) {
+  out.clear();
+  const double reach2 = reach * reach;
+  const auto& x = lists.x_ref;
+  for (std::size_t i = 0; i < lists.ff.rows(); ++i)
+    for (std::uint32_t n = lists.ff.start[i]; n < lists.ff.start[i + 1]; ++n) {
+      const std::uint32_t k = lists.ff.k[n];
+      if (box.min_image(x[i] - x[k]).squaredNorm() < reach2) out.push_back({static_cast<std::uint32_t>(i), k, false});
+    }
+}
+
+void contact_candidates(const std::vector<ContactPair>& ff_near, const std::vector<IndexPair>& fw,
+                        const std::vector<Vec3>& x, const WallParticles& walls, const Box& box, double radius,
+                        double margin, std::vector<ContactPair>& out) {
+  out.clear();
+  const double reach = 2.0 * radius + margin, reach2 = reach * reach;
+  for (const ContactPair& c : ff_near)
+    if (box.min_image(x[c.i] - x[c.k]).squaredNorm() < reach2) out.push_back(c);
+  for (const auto& [i, k] : fw)
+    if (box.min_image(x[i] - walls.x[k]).squaredNorm() < reach2) out.push_back({i, k, true});
+}
+
 namespace {
 // Corrections above this multiple of the Newton tolerance are line-searched.
 constexpr double k_line_search_above = 100.0;

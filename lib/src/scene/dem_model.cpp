@@ -11,6 +11,8 @@
 
 namespace mrf {
 
+const char* to_string(ContactFormulation f) { return f == ContactFormulation::dual ? "dual" : "primal"; }
+
 namespace {
 // Contact candidates of an implicit step are the pairs within 2R + margin at
 // x_n; a step that moves a particle (or the walls) by more than margin/2 is
@@ -74,16 +76,24 @@ DemModel::Attempt DemModel::attempt(double dt, const NewtonOptions& nopt) {
     b_[i] = x0_[i] + dt * w_[i];
     f.x[i] = x0_[i] + dt * f.v[i];  // predictor
   }
-  cell_.walls.x = walls0_;
+  cell_.walls.x = walls0_.x;
   move_walls(cell_.walls, p_.shear_rate, dt);
-  // Newton starts from the predictor or from x_n, whichever is lower in the
-  // merit function: after a sudden change (a contact made or broken) the
-  // extrapolated slope can throw the predictor far off.
-  const double phi_pred = newton_.merit(candidates_, b_, cell_.walls, cell_.box, p_.radius, p_.hertz_k, dt_over_gamma, f.x);
-  if (newton_.merit(candidates_, b_, cell_.walls, cell_.box, p_.radius, p_.hertz_k, dt_over_gamma, x0_) < phi_pred)
-    f.x = x0_;
   Attempt a;
-  a.newton = newton_.solve(candidates_, b_, cell_.walls, cell_.box, p_.radius, p_.hertz_k, dt_over_gamma, nopt, f.x);
+  if (opt_.formulation == ContactFormulation::dual) {
+    // Starts from the contact forces at x_n (walls at t_n).
+    const DualOptions dopt{nopt.tol, nopt.max_iterations, nopt.linear_rtol};
+    a.newton = dual_.solve(candidates_, b_, x0_, walls0_, cell_.walls, cell_.box, p_.radius, p_.hertz_k, dt_over_gamma,
+                           dopt, f.x);
+  } else {
+    // Newton starts from the predictor or from x_n, whichever is lower in the
+    // merit function: after a sudden change (a contact made or broken) the
+    // extrapolated slope can throw the predictor far off.
+    const double phi_pred =
+        newton_.merit(candidates_, b_, cell_.walls, cell_.box, p_.radius, p_.hertz_k, dt_over_gamma, f.x);
+    if (newton_.merit(candidates_, b_, cell_.walls, cell_.box, p_.radius, p_.hertz_k, dt_over_gamma, x0_) < phi_pred)
+      f.x = x0_;
+    a.newton = newton_.solve(candidates_, b_, cell_.walls, cell_.box, p_.radius, p_.hertz_k, dt_over_gamma, nopt, f.x);
+  }
   counters_.newton_iterations += a.newton.iterations;
   counters_.linear_iterations += a.newton.linear_iterations;
   for (std::size_t i = 0; i < n; ++i) {
@@ -103,10 +113,14 @@ void DemModel::implicit_step() {
   auto& f = cell_.free;
   const double r = p_.radius, margin = k_margin_over_radius * r;
   const double wall_speed = std::abs(p_.shear_rate) * 0.5 * cell_.box.gap;
-  contact_candidates(lists_, f.x, cell_.walls, cell_.box, r, margin, candidates_);
+  if (near_builds_ != lists_.builds) {
+    near_pairs(lists_, cell_.box, 2.0 * r + margin + lists_.skin, near_ff_);
+    near_builds_ = lists_.builds;
+  }
+  contact_candidates(near_ff_, lists_.fw, f.x, cell_.walls, cell_.box, r, margin, candidates_);
   contact_forces(candidates_, f.x, cell_.walls, cell_.box, r, p_.hertz_k, fc_);
   x0_ = f.x;
-  walls0_ = cell_.walls.x;
+  walls0_.x = cell_.walls.x;
   w_.resize(f.size());  // explicit drift u(x_n) + F_nc(x_n)/gamma, F_nc = F - F_c
   for (std::size_t i = 0; i < f.size(); ++i)
     w_[i] = drift_velocity(x0_[i], f.f[i] - fc_[i], 1.0 / p_.gamma, p_.shear_rate);

@@ -41,6 +41,17 @@ struct ContactPair {
 void contact_candidates(const DemPairLists& lists, const std::vector<Vec3>& x, const WallParticles& walls,
                         const Box& box, double radius, double margin, std::vector<ContactPair>& out);
 
+// The same search in two stages: near_pairs keeps the free-free pairs of the
+// Verlet list within `reach` (m) at the list's build positions; with reach =
+// 2R + margin + skin it holds every pair that can come within 2R + margin
+// before the next rebuild. contact_candidates then filters that short list
+// and the free-wall list at x, giving the same pairs in the same order as
+// the search over the whole list.
+void near_pairs(const DemPairLists& lists, const Box& box, double reach, std::vector<ContactPair>& out);
+void contact_candidates(const std::vector<ContactPair>& ff_near, const std::vector<IndexPair>& fw,
+                        const std::vector<Vec3>& x, const WallParticles& walls, const Box& box, double radius,
+                        double margin, std::vector<ContactPair>& out);
+
 // Hertz forces (N) of the candidate pairs at positions x into f (overwritten).
 // Returns the largest overlap (m).
 double contact_forces(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& x,

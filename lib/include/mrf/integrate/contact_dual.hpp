@@ -1,0 +1,58 @@
+// The backward Euler contact step of implicit_contact.hpp solved for the
+// contact forces instead of the positions (the compliance or "dual" form).
+//
+// The step is y = b + (dt/gamma) sum_c G_c lambda_c, where lambda_c >= 0 is the
+// Hertz force of candidate pair c and G_c puts +n_c on i and -n_c on k (n_c the
+// unit vector from k to i at y). The Hertz law, written as a compliance,
+//   phi_c(lambda) = h_c(y(lambda)) - (lambda_c / k)^{2/3} = 0   (lambda_c > 0),
+//   lambda_c = 0 and h_c(y(lambda)) <= 0                        (open),
+// closes the system. Newton on phi with the normals frozen over one linear
+// solve: (A + C) dlambda = phi on the active contacts, A = (dt/gamma) G^T G (the
+// Delassus operator of the mobility, exact and linear) and C the diagonal
+// compliance derivative (2/3) k^{-2/3} lambda^{-1/3}. In the position form the
+// stiff Hertz law is the Jacobian, whose stiffness changes on the scale of the
+// overlap itself; here the linear part dominates (A / C ~ (dt/gamma) k_eff,
+// the stiffness ratio of the step) and the Hertz nonlinearity is a small
+// correction, so Newton needs few iterations from the forces of the last step.
+// Open contacts are handled by projection (lambda >= 0) with an active set.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "mrf/box.hpp"
+#include "mrf/integrate/implicit_contact.hpp"
+#include "mrf/state.hpp"
+
+namespace mrf {
+
+struct DualOptions {
+  double tol = 0;               // m: converged when every |phi_c| (overlap error) is below it
+  int max_iterations = 30;
+  double linear_rtol = 1e-1;    // relative residual of each CG solve
+};
+
+class ContactDual {
+ public:
+  // Solves the step for y (out), starting from the forces of the pairs at
+  // positions x_start with the walls at walls_start (the last step's contact
+  // forces); `walls` at the end of the step. dt_over_gamma in s/kg.
+  NewtonResult solve(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& b,
+                     const std::vector<Vec3>& x_start, const WallParticles& walls_start, const WallParticles& walls,
+                     const Box& box, double radius,
+                     double hertz_k, double dt_over_gamma, const DualOptions& opt, std::vector<Vec3>& y);
+
+ private:
+  void positions(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& b, double dt_over_gamma,
+                 std::vector<Vec3>& y) const;  // y = b + (dt/gamma) G lambda
+  void apply(const std::vector<double>& p, std::vector<double>& out, double dt_over_gamma);  // (A + C) p
+  long solve_cg(double rtol, double dt_over_gamma);
+
+  std::vector<double> lambda_, comp_, phi_;  // per candidate pair: force (N), compliance slope (m/N), residual (m)
+  std::vector<Vec3> n_;                      // unit normals (k to i) per pair, frozen over a linear solve
+  std::vector<std::uint32_t> act_;           // active pairs
+  std::vector<double> d_, r_, z_, p_, q_, diag_;  // CG on the active set (Jacobi preconditioner)
+  std::vector<Vec3> s_;                      // per particle scratch: G p
+  const std::vector<ContactPair>* pairs_ = nullptr;
+};
+
+}  // namespace mrf

@@ -1,0 +1,144 @@
+#include "mrf/integrate/contact_dual.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "mrf/forces/hertz.hpp"
+
+namespace mrf {
+
+namespace {
+Vec3 pair_vector(const ContactPair& c, const std::vector<Vec3>& x, const WallParticles& walls, const Box& box) {
+  return box.min_image(x[c.i] - (c.wall ? walls.x[c.k] : x[c.k]));
+}
+}  // namespace
+
+void ContactDual::positions(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& b, double dt_over_gamma,
+                            std::vector<Vec3>& y) const {
+  y = b;
+  for (std::size_t c = 0; c < pairs.size(); ++c) {
+    if (lambda_[c] <= 0) continue;
+    const Vec3 f = (dt_over_gamma * lambda_[c]) * n_[c];
+    y[pairs[c].i] += f;
+    if (!pairs[c].wall) y[pairs[c].k] -= f;
+  }
+}
+
+// (A + C) p on the active set: A = (dt/gamma) G^T G, C diagonal.
+void ContactDual::apply(const std::vector<double>& p, std::vector<double>& out, double dt_over_gamma) {
+  const auto& pairs = *pairs_;
+  for (std::size_t a = 0; a < act_.size(); ++a) {
+    const ContactPair& c = pairs[act_[a]];
+    s_[c.i].setZero();
+    if (!c.wall) s_[c.k].setZero();
+  }
+  for (std::size_t a = 0; a < act_.size(); ++a) {
+    const ContactPair& c = pairs[act_[a]];
+    const Vec3 g = p[a] * n_[act_[a]];
+    s_[c.i] += g;
+    if (!c.wall) s_[c.k] -= g;
+  }
+  out.resize(act_.size());
+  for (std::size_t a = 0; a < act_.size(); ++a) {
+    const std::uint32_t e = act_[a];
+    const ContactPair& c = pairs[e];
+    const Vec3 rel = c.wall ? s_[c.i] : Vec3(s_[c.i] - s_[c.k]);
+    out[a] = dt_over_gamma * n_[e].dot(rel) + comp_[e] * p[a];
+  }
+}
+
+long ContactDual::solve_cg(double rtol, double dt_over_gamma) {
+  const std::size_t m = act_.size();
+  const auto& pairs = *pairs_;
+  diag_.resize(m);
+  for (std::size_t a = 0; a < m; ++a)
+    diag_[a] = dt_over_gamma * (pairs[act_[a]].wall ? 1.0 : 2.0) + comp_[act_[a]];
+  auto dot = [](const std::vector<double>& u, const std::vector<double>& v) {
+    double s = 0;
+    for (std::size_t i = 0; i < u.size(); ++i) s += u[i] * v[i];
+    return s;
+  };
+  d_.assign(m, 0.0);
+  r_.resize(m);
+  for (std::size_t a = 0; a < m; ++a) r_[a] = phi_[act_[a]];
+  z_.resize(m);
+  for (std::size_t a = 0; a < m; ++a) z_[a] = r_[a] / diag_[a];
+  p_ = z_;
+  double rz = dot(r_, z_);
+  const double stop2 = rtol * rtol * dot(r_, r_);
+  const long max_it = 10 * static_cast<long>(m) + 10;
+  long it = 0;
+  while (dot(r_, r_) > stop2 && it < max_it) {
+    apply(p_, q_, dt_over_gamma);
+    const double alpha = rz / dot(p_, q_);
+    for (std::size_t a = 0; a < m; ++a) {
+      d_[a] += alpha * p_[a];
+      r_[a] -= alpha * q_[a];
+      z_[a] = r_[a] / diag_[a];
+    }
+    const double rz_new = dot(r_, z_);
+    const double beta = rz_new / rz;
+    rz = rz_new;
+    for (std::size_t a = 0; a < m; ++a) p_[a] = z_[a] + beta * p_[a];
+    ++it;
+  }
+  return it;
+}
+
+NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& b,
+                                const std::vector<Vec3>& x_start, const WallParticles& walls_start,
+                                const WallParticles& walls, const Box& box,
+                                double radius, double hertz_k, double dt_over_gamma, const DualOptions& opt,
+                                std::vector<Vec3>& y) {
+  pairs_ = &pairs;
+  const std::size_t np = pairs.size();
+  const double two_r = 2.0 * radius;
+  lambda_.resize(np);
+  n_.resize(np);
+  comp_.resize(np);
+  phi_.resize(np);
+  s_.resize(y.size());
+  // Warm start: the Hertz forces at x_start, along its normals.
+  for (std::size_t c = 0; c < np; ++c) {
+    const Vec3 r = pair_vector(pairs[c], x_start, walls_start, box);
+    const double rn = r.norm();
+    n_[c] = r / rn;
+    lambda_[c] = hertz_force(two_r - rn, hertz_k);
+  }
+  const double k23 = std::cbrt(hertz_k * hertz_k);  // k^{2/3}
+  NewtonResult res;
+  for (res.iterations = 1; res.iterations <= opt.max_iterations; ++res.iterations) {
+    positions(pairs, b, dt_over_gamma, y);
+    // Residuals at y, normals updated to y.
+    act_.clear();
+    double worst = 0;
+    for (std::size_t c = 0; c < np; ++c) {
+      const Vec3 r = pair_vector(pairs[c], y, walls, box);
+      const double rn = r.norm(), h = two_r - rn;
+      n_[c] = r / rn;
+      if (lambda_[c] <= 0 && h <= 0) continue;  // open and staying open
+      const double h_lambda = std::cbrt(lambda_[c] * lambda_[c]) / k23;  // (lambda/k)^{2/3}
+      phi_[c] = h - h_lambda;
+      // Compliance slope: of the current force, or for a contact closing
+      // from zero force, of the Hertz law at the overlap y gives it.
+      comp_[c] = lambda_[c] > 0 ? 2.0 * h_lambda / (3.0 * lambda_[c]) : 1.0 / hertz_local_stiffness(h, hertz_k);
+      act_.push_back(static_cast<std::uint32_t>(c));
+      if (std::abs(phi_[c]) > worst) worst = std::abs(phi_[c]), res.worst = pairs[c].i;
+    }
+    res.last_correction = worst;
+    if (!std::isfinite(worst)) return res;
+    if (worst <= opt.tol) {
+      res.converged = true;
+      return res;
+    }
+    res.linear_iterations += solve_cg(opt.linear_rtol, dt_over_gamma);
+    for (std::size_t a = 0; a < act_.size(); ++a) {
+      const std::uint32_t c = act_[a];
+      lambda_[c] = std::max(0.0, lambda_[c] + d_[a]);
+    }
+  }
+  res.iterations = opt.max_iterations;
+  return res;
+}
+
+}  // namespace mrf
