@@ -1,9 +1,9 @@
 // The implicit integrator in a whole run of the small scene
 // (experiments/scenes/small_dem_stokes.toml): the automatic choice prefers it
-// at the real modulus of iron, the run writes its step and iteration counts
-// and time-series rows by strain interval, its steps are error-controlled
-// (bounded by the magnetic accuracy limit, far above the explicit contact
-// limits), and its steady stress equals the explicit one within the error
+// at the real modulus of iron and not at a soft one, the run writes its step
+// and iteration counts and time-series rows by strain interval, its steps are
+// error-controlled (bounded by the wall motion the contact search allows, far
+// above the explicit contact limits), and its steady stress equals the explicit one within the error
 // bars at a modulus where the explicit scheme is affordable (about 5 s).
 #include <gtest/gtest.h>
 
@@ -27,7 +27,7 @@ LoadedScene small(const std::vector<std::string>& sets) {
 
 TEST(ImplicitChoice, AutoPrefersImplicitAtTheRealModulusAndExplicitAtASoftOne) {
   for (const auto& [youngs, want] : {std::pair{"\"200 GPa\"", IntegratorId::implicit},
-                                     std::pair{"\"2 GPa\"", IntegratorId::verlet_exp}}) {
+                                     std::pair{"\"0.2 GPa\"", IntegratorId::verlet_exp}}) {
     const LoadedScene s = small({std::string("contact.youngs_modulus=") + youngs});
     const DemParams p = dem_params(s.config);
     const TimeStepChoice t = choose_time_step(s, p);
@@ -44,7 +44,7 @@ TEST(ImplicitChoice, AutoPrefersImplicitAtTheRealModulusAndExplicitAtASoftOne) {
 }
 
 TEST(ImplicitRun, ShortRunReportsCountsAndBoundedSteps) {
-  const LoadedScene s = small({"drive.strain=0.15", "drive.warmup_strain=0.05", "numerics.integrator=implicit"});
+  const LoadedScene s = small({"drive.strain=0.35", "drive.warmup_strain=0.1", "numerics.integrator=implicit"});
   const RunSummary r = run_scene(s, RunOptions{"", true});
   const DemParams p = dem_params(s.config);
   const double explicit_dt = smallest(dem_limits(p, s.config, IntegratorId::verlet_exp));
@@ -56,7 +56,7 @@ TEST(ImplicitRun, ShortRunReportsCountsAndBoundedSteps) {
               r.extra.at("implicit_rejected_steps"), r.extra.at("implicit_newton_iterations"),
               r.extra.at("implicit_linear_iterations"), r.wall_seconds);
   EXPECT_EQ(r.integrator, "implicit");
-  EXPECT_NEAR(r.extra.at("implicit_dt_mean") * static_cast<double>(r.steps) * r.shear_rate, 0.15, 1e-9);
+  EXPECT_NEAR(r.extra.at("implicit_dt_mean") * static_cast<double>(r.steps) * r.shear_rate, 0.35, 1e-9);
   EXPECT_LE(r.extra.at("implicit_dt_max"), r.dt * (1 + 1e-12));  // the bound holds
   EXPECT_GT(r.extra.at("implicit_dt_mean"), 5 * explicit_dt);
   EXPECT_GE(r.extra.at("implicit_newton_iterations"), static_cast<double>(r.steps));

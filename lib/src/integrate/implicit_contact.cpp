@@ -34,15 +34,18 @@ void contact_candidates(const DemPairLists& lists, const std::vector<Vec3>& x, c
     if (box.min_image(x[i] - walls.x[k]).squaredNorm() < reach2) out.push_back({i, k, true});
 }
 
-void near_pairs(const DemPairLists& lists, const Box& box, double reach, std::vector<ContactPair>& out) {
+void near_pairs(const PairRows& ff, const std::vector<Vec3>& x, const Box& box, double reach,
+                std::vector<ContactPair>& out) {
   out.clear();
   const double reach2 = reach * reach;
-  const auto& x = lists.x_ref;
-  for (std::size_t i = 0; i < lists.ff.rows(); ++i)
-    for (std::uint32_t n = lists.ff.start[i]; n < lists.ff.start[i + 1]; ++n) {
-      const std::uint32_t k = lists.ff.k[n];
+  for (std::size_t i = 0; i < ff.rows(); ++i)
+    for (std::uint32_t n = ff.start[i]; n < ff.start[i + 1]; ++n) {
+      const std::uint32_t k = ff.k[n];
       if (box.min_image(x[i] - x[k]).squaredNorm() < reach2) out.push_back({static_cast<std::uint32_t>(i), k, false});
     }
+  std::sort(out.begin(), out.end(), [](const ContactPair& a, const ContactPair& b) {
+    return a.i != b.i ? a.i < b.i : a.k < b.k;
+  });
 }
 
 void contact_candidates(const std::vector<ContactPair>& ff_near, const std::vector<IndexPair>& fw,

@@ -93,6 +93,23 @@ std::vector<StabilityLimit> dem_limits(const DemParams& p, const SceneConfig& c,
                      (inertial ? ", impact at " + fmt(p.impact_speed) + " m/s" : "") + ")"});
   out.push_back({"drag relaxation", inf,
                  "tau_p = " + fmt(p.tau_p) + (inertial ? " s (integrated exactly)" : " s (inertia neglected)")});
+  if (scheme == IntegratorId::implicit) {
+    // The implicit scheme's step is chosen by its error control; these bound
+    // it from above. Explicit dipoles: the transverse (aligning) stiffness of
+    // a head-to-tail pair at contact is F/(2R), and the alternating mode of a
+    // chain relaxes at 4 (F/2R)/gamma, so explicit Euler on it is stable for
+    // dt < gamma R / F. Contact candidates: a step must not move the walls by
+    // more than half the candidate margin (dem_model.cpp), or a contact could
+    // be missed.
+    if (p.contact_force > 0)
+      out.push_back({"dipole stability", p.gamma * p.radius / p.contact_force,
+                     "explicit dipoles, aligning mode of a chain: gamma R / F_contact"});
+    if (p.shear_rate > 0)
+      out.push_back({"contact margin", 0.5 * k_contact_margin_over_radius * p.radius / (p.shear_rate * 0.5 * c.gap),
+                     "walls move at most half the candidate margin (" + fmt(k_contact_margin_over_radius) +
+                         " R) per step"});
+    return out;
+  }
   // Accuracy bounds: a contact pair under the head-to-tail force, or a wall
   // sphere, moves at most 5 % of R per step.
   constexpr double k_frac = 0.05;

@@ -5,14 +5,14 @@
 
 namespace mrf {
 
-namespace {
-// Largest displacement (m) of the free particles from `ref` (minimum image).
 double max_displacement(const std::vector<Vec3>& x, const std::vector<Vec3>& ref, const Box& box) {
   const MinImageYZ mi(box);
   double max2 = 0;
   for (std::size_t i = 0; i < x.size(); ++i) max2 = std::max(max2, mi.norm2(x[i], ref[i]));
   return std::sqrt(max2);
 }
+
+namespace {
 
 bool ff_stale(const DemPairLists& l, const FreeParticles& free, const Box& box) {
   if (l.builds == 0 || l.x_ref.size() != free.size() || l.ff.rows() != free.size()) return true;

@@ -59,7 +59,7 @@ void DemModel::load(ArchiveReader& in) {
   in.get(dt_);
   in.get(dt_try_);
   in.get(counters_);
-  near_builds_ = -1;  // derived from the lists: rebuilt at the next implicit step
+  near_x_.clear();  // the near list is derived: rebuilt at the next implicit step
 }
 
 }  // namespace mrf

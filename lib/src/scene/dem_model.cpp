@@ -15,9 +15,11 @@ const char* to_string(ContactFormulation f) { return f == ContactFormulation::du
 
 namespace {
 // Contact candidates of an implicit step are the pairs within 2R + margin at
-// x_n; a step that moves a particle (or the walls) by more than margin/2 is
-// rejected, so no contact can be missed. Lists are built with this reach.
-constexpr double k_margin_over_radius = 0.2;
+// x_n (margin = k_contact_margin_over_radius R, stability.hpp); a step that
+// moves a particle (or the walls) by more than margin/2 is rejected, so no
+// contact can be missed. Lists are built with this reach.
+// Skin of the near list of contact candidates (a refresh scans the dipole list).
+constexpr double k_near_skin_over_radius = 1.0;
 // A step shorter than this fraction of the largest allowed one is a failure.
 constexpr double k_dt_floor = 1e-7;
 }  // namespace
@@ -30,9 +32,10 @@ DemModel::DemModel(ShearCell cell, const DemParams& params, IntegratorId scheme,
   cell_.free.f.resize(cell_.free.size(), Vec3::Zero());
   const double two_r = 2.0 * p_.radius;
   const double contact_reach =
-      scheme_ == IntegratorId::implicit ? two_r + k_margin_over_radius * p_.radius : two_r;
+      scheme_ == IntegratorId::implicit ? two_r + k_contact_margin_over_radius * p_.radius : two_r;
   const double ff_range = p_.dipole_pref > 0 ? std::max(p_.dipole_cutoff, contact_reach) : contact_reach;
   lists_ = make_pair_lists(ff_range, cell_.walls.size() > 0 ? contact_reach : 0.0, p_.skin);
+  near_reach_ = std::min(ff_range, contact_reach + k_near_skin_over_radius * p_.radius);
   overlap_limit_ = scheme_ == IntegratorId::implicit ? p_.radius : critical_overlap(p_, scheme_, dt_);
   update_forces();
 }
@@ -111,11 +114,12 @@ DemModel::Attempt DemModel::attempt(double dt, const NewtonOptions& nopt) {
 // margin (dt/2), or the error estimate exceeds the tolerance.
 void DemModel::implicit_step() {
   auto& f = cell_.free;
-  const double r = p_.radius, margin = k_margin_over_radius * r;
+  const double r = p_.radius, margin = k_contact_margin_over_radius * r;
   const double wall_speed = std::abs(p_.shear_rate) * 0.5 * cell_.box.gap;
-  if (near_builds_ != lists_.builds) {
-    near_pairs(lists_, cell_.box, 2.0 * r + margin + lists_.skin, near_ff_);
-    near_builds_ = lists_.builds;
+  const double near_skin = near_reach_ - (2.0 * r + margin);
+  if (near_x_.size() != f.size() || 2.0 * max_displacement(f.x, near_x_, cell_.box) > near_skin) {
+    near_pairs(lists_.ff, f.x, cell_.box, near_reach_, near_ff_);
+    near_x_ = f.x;
   }
   contact_candidates(near_ff_, lists_.fw, f.x, cell_.walls, cell_.box, r, margin, candidates_);
   contact_forces(candidates_, f.x, cell_.walls, cell_.box, r, p_.hertz_k, fc_);

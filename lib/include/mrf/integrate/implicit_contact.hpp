@@ -41,13 +41,14 @@ struct ContactPair {
 void contact_candidates(const DemPairLists& lists, const std::vector<Vec3>& x, const WallParticles& walls,
                         const Box& box, double radius, double margin, std::vector<ContactPair>& out);
 
-// The same search in two stages: near_pairs keeps the free-free pairs of the
-// Verlet list within `reach` (m) at the list's build positions; with reach =
-// 2R + margin + skin it holds every pair that can come within 2R + margin
-// before the next rebuild. contact_candidates then filters that short list
-// and the free-wall list at x, giving the same pairs in the same order as
-// the search over the whole list.
-void near_pairs(const DemPairLists& lists, const Box& box, double reach, std::vector<ContactPair>& out);
+// The same search in two stages. near_pairs keeps the free-free pairs of a
+// Verlet list (valid at x) closer than `reach` (m) at x, sorted by (i, k) so
+// that the order does not depend on when the list was built. With reach =
+// 2R + margin + s it holds every pair that can come within 2R + margin until
+// some particle has moved s/2. contact_candidates then filters that short
+// list and the free-wall list at x.
+void near_pairs(const PairRows& ff, const std::vector<Vec3>& x, const Box& box, double reach,
+                std::vector<ContactPair>& out);
 void contact_candidates(const std::vector<ContactPair>& ff_near, const std::vector<IndexPair>& fw,
                         const std::vector<Vec3>& x, const WallParticles& walls, const Box& box, double radius,
                         double margin, std::vector<ContactPair>& out);

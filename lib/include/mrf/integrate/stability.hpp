@@ -32,9 +32,15 @@ double overdamped_contact_limit(double gamma, double k_eff);
 // impact at the expected approach speed (REFERENCE TEST 2.1).
 double expected_overlap(const DemParams& p, IntegratorId scheme);
 
+// Contact candidates of an implicit step are the pairs within 2R + margin at
+// the start of the step, margin = this x R; a step that moves a particle or
+// the walls by more than margin/2 is rejected.
+inline constexpr double k_contact_margin_over_radius = 0.2;
+
 // All limits of a DEM scene for the given scheme. For `implicit` the contact
-// and drag limits are infinite and the binding one is an accuracy bound (the
-// magnetic or shear motion per step): the largest step the error control may take.
+// and drag limits are infinite, and the binding one is the stability of its
+// explicit dipole forces or the wall motion per step that the contact search
+// allows: the largest step the error control may take.
 std::vector<StabilityLimit> dem_limits(const DemParams& p, const SceneConfig& c, IntegratorId scheme);
 
 // Contact limit for the largest overlap actually seen (checked during a run).
@@ -45,13 +51,13 @@ double smallest(const std::vector<StabilityLimit>& limits);
 // Automatic choice of the integrator (numerics.integrator = "auto"): the
 // explicit scheme whose binding limit is largest (ties to verlet_exp), unless
 // that limit is more than k_implicit_preference times below the implicit
-// step bound (the magnetic / shear accuracy limit), then `implicit`. The
-// factor is the measured break-even on the small scene at 200 GPa: the
-// error-controlled steps average 0.9 of the bound, explicit runs at
-// dt_safety = 0.5 of its limit, and one implicit step costs about 12
-// explicit ones (reports/work_precision/README.md), so implicit wins above
-// a limit ratio of about 6.7.
-inline constexpr double k_implicit_preference = 8.0;
+// step bound, then `implicit`. The factor is the measured break-even on the
+// small scene at Mn 1e-2 (one strain unit, one thread, side by side): the
+// error-controlled steps average about 0.55 of the bound, explicit runs at
+// dt_safety = 0.5 of its limit, and one implicit step (dual solver) costs
+// about 5.5 verlet_exp steps, so implicit wins above a limit ratio of about
+// 5; at 2 GPa (ratio 6.1) it took 0.25 s against verlet_exp's 0.36 s.
+inline constexpr double k_implicit_preference = 5.0;
 IntegratorId auto_integrator(const std::vector<StabilityLimit>& verlet_exp,
                              const std::vector<StabilityLimit>& overdamped,
                              const std::vector<StabilityLimit>& implicit);

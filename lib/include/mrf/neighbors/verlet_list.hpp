@@ -25,6 +25,9 @@ struct DemPairLists {
   long builds = 0;              // builds of either list
 };
 
+// Largest displacement (m) of the points x from `ref` (minimum image).
+double max_displacement(const std::vector<Vec3>& x, const std::vector<Vec3>& ref, const Box& box);
+
 DemPairLists make_pair_lists(double ff_range, double fw_range, double skin);
 
 // Rebuilds the lists that may be stale (both on the first call, or when the

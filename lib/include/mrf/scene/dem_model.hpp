@@ -108,11 +108,13 @@ class DemModel {
   ContactNewton newton_;
   ContactDual dual_;
   std::vector<ContactPair> candidates_;
-  // Free-free pairs of the Verlet list within contact reach + skin, refreshed
-  // when the list is rebuilt (builds counter): the candidates are searched
-  // here instead of in the longer dipole list.
+  // Free-free pairs within near_reach_ = 2R + margin + near skin at the
+  // positions near_x_, taken from the (longer) dipole Verlet list; refreshed
+  // when a particle has moved half the near skin. The contact candidates of
+  // each step are searched here.
   std::vector<ContactPair> near_ff_;
-  long near_builds_ = -1;
+  std::vector<Vec3> near_x_;
+  double near_reach_ = 0;
   std::vector<Vec3> x0_, b_, fc_;
   WallParticles walls0_;
 };
