@@ -570,9 +570,9 @@ TEST(RunIntegratorChoice, AutoPicksTheSchemeWhoseBindingLimitIsLargest) {
 }
 
 TEST(RunIntegratorChoice, TinyDensityRunReportsTheSchemeOfTheRule) {
-  const std::vector<std::string> set = {"particles.density=7.8", "contact.youngs_modulus=\"0.2 GPa\"",
+  const std::vector<std::string> set = {"particles.density=7.8", "contact.youngs_modulus=\"0.1 GPa\"",
                                         "numerics.integrator=auto",
-                                        "drive.strain=0.05", "drive.warmup_strain=0.02",
+                                        "drive.strain=0.08", "drive.warmup_strain=0.02",
                                         "output.every=0"};
   const LoadedScene s = scene(set);
   const DemParams p = dem_params(s.config);
