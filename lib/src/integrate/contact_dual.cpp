@@ -60,7 +60,7 @@ long ContactDual::solve_cg(double rtol, double dt_over_gamma) {
   };
   d_.assign(m, 0.0);
   r_.resize(m);
-  for (std::size_t a = 0; a < m; ++a) r_[a] = phi_[act_[a]];
+  for (std::size_t a = 0; a < m; ++a) r_[a] = rhs_[act_[a]];
   z_.resize(m);
   for (std::size_t a = 0; a < m; ++a) z_[a] = r_[a] / diag_[a];
   p_ = z_;
@@ -97,6 +97,7 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
   n_.resize(np);
   comp_.resize(np);
   phi_.resize(np);
+  rhs_.resize(np);
   s_.resize(y.size());
   // Warm start: the Hertz forces at x_start, along its normals.
   for (std::size_t c = 0; c < np; ++c) {
@@ -124,6 +125,19 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
       comp_[c] = lambda_[c] > 0 ? 2.0 * h_lambda / (3.0 * lambda_[c]) : 1.0 / hertz_local_stiffness(h, hertz_k);
       act_.push_back(static_cast<std::uint32_t>(c));
       if (std::abs(phi_[c]) > worst) worst = std::abs(phi_[c]), res.worst = pairs[c].i;
+    }
+    // y was placed with the normals of the last iterate; with the normals
+    // just updated, y - b - (dt/gamma) G(y) lambda = r_y. Newton on (y,
+    // lambda) with r_y eliminated: (A + C) dlambda = phi + G^T r_y, and the
+    // next y is b + (dt/gamma) G(y) (lambda + dlambda). Without the G^T r_y
+    // term the normals converge only linearly (30 % more iterations).
+    positions(pairs, b, dt_over_gamma, y_next_);
+    for (auto c : act_) {
+      const ContactPair& pc = pairs[c];
+      const Vec3 ry = pc.wall ? Vec3(y[pc.i] - y_next_[pc.i])
+                              : Vec3((y[pc.i] - y_next_[pc.i]) - (y[pc.k] - y_next_[pc.k]));
+      rhs_[c] = phi_[c] + n_[c].dot(ry);
+      if (std::abs(rhs_[c]) > worst) worst = std::abs(rhs_[c]), res.worst = pc.i;
     }
     res.last_correction = worst;
     if (!std::isfinite(worst)) return res;

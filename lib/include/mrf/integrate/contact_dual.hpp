@@ -47,11 +47,13 @@ class ContactDual {
   void apply(const std::vector<double>& p, std::vector<double>& out, double dt_over_gamma);  // (A + C) p
   long solve_cg(double rtol, double dt_over_gamma);
 
-  std::vector<double> lambda_, comp_, phi_;  // per candidate pair: force (N), compliance slope (m/N), residual (m)
-  std::vector<Vec3> n_;                      // unit normals (k to i) per pair, frozen over a linear solve
+  // Per candidate pair: force (N), compliance slope (m/N), overlap residual
+  // and Newton right-hand side (m), unit normal (k to i; frozen over a solve).
+  std::vector<double> lambda_, comp_, phi_, rhs_;
+  std::vector<Vec3> n_;
   std::vector<std::uint32_t> act_;           // active pairs
   std::vector<double> d_, r_, z_, p_, q_, diag_;  // CG on the active set (Jacobi preconditioner)
-  std::vector<Vec3> s_;                      // per particle scratch: G p
+  std::vector<Vec3> s_, y_next_;             // per particle: G p (scratch), positions with the new normals
   const std::vector<ContactPair>* pairs_ = nullptr;
 };
 
