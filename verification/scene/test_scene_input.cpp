@@ -140,6 +140,7 @@ TEST(SceneInput, OptionalKeysTakeTheirDefaults) {
   EXPECT_FALSE(c.dt.has_value());
   EXPECT_EQ(c.skin, 0.0);
   EXPECT_EQ(c.dt_safety, 0.5);
+  EXPECT_EQ(c.implicit_tol, 1e-2);
   EXPECT_EQ(c.sound_speed, 0.0);
   EXPECT_EQ(c.threads, 0);
   EXPECT_EQ(c.every, 0);
@@ -282,6 +283,7 @@ const Bad k_bad[] = {
      "5", "must be < drive.strain"},
     {"BadIntegrator", "integrator =", "integrator = \"rk4\"", "numerics.integrator", "\"rk4\"",
      "expected one of: auto, verlet_exp, overdamped, implicit"},
+    {"ImplicitTolAboveOne", "skin =", "implicit_tol = 2", "numerics.implicit_tol", "2", "must be in (0, 1]"},
     {"BadModel", "model =", "model = \"dem\"", "scene.model", "\"dem\"",
      "expected one of: dem_stokes, demsph_stokes, demsph_dd"},
     {"CutoffBeyondMinimumImage", "dipole_cutoff =", "dipole_cutoff = \"25 um\"",

@@ -100,6 +100,7 @@ const KeySpec k_keys[] = {
     {"numerics.dt", &C::dt, Dim::time, Need::optional, k_pos},
     {"numerics.skin", &C::skin, Dim::length, Need::optional, k_nonneg},
     {"numerics.dt_safety", &C::dt_safety, Dim::none, Need::optional, {0, 1, true, false}},
+    {"numerics.implicit_tol", &C::implicit_tol, Dim::none, Need::optional, {0, 1, true, false}},
     {"numerics.threads", &C::threads, Dim::none, Need::optional, k_any},
     {"output.every", &C::every, Dim::none, Need::optional, k_any},
     {"output.frames", &C::frames, Dim::none, Need::optional, k_any},

@@ -157,7 +157,7 @@ std::string scene_fingerprint(const SceneConfig& c) {
   for (double v : {c.gap, c.ly, c.lz, c.radius, c.volume_fraction, c.density, c.magnetization, c.dipole_cutoff,
                    c.wall_spacing, c.youngs_modulus, c.poisson_ratio, c.viscosity, c.fluid_density, c.sph_spacing,
                    c.sound_speed, c.mason, c.shear_rate, c.strain, c.warmup_strain, c.dt.value_or(-1.0), c.skin,
-                   c.dt_safety}) {
+                   c.dt_safety, c.implicit_tol}) {
     std::snprintf(buf, sizeof buf, "%a;", v);
     out += buf;
   }

@@ -47,6 +47,7 @@ struct SceneConfig {
   std::optional<double> dt;    // s; empty = automatic
   double skin = 0;             // m, Verlet skin; 0 = 0.2 radius
   double dt_safety = 0.5;      // fraction of the smallest stability limit used by automatic dt
+  double implicit_tol = 1e-2;  // implicit scheme: largest local error per step / radius
   int threads = 0;             // OpenMP threads; 0 = OMP default
   // [output]
   int every = 0;               // steps between time-series rows; 0 = about 2000 rows per run
