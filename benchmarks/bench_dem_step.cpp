@@ -39,9 +39,11 @@ void BM_PaperStep(benchmark::State& state, mrf::IntegratorId scheme) {
 BENCHMARK_CAPTURE(BM_PaperStep, verlet_exp, mrf::IntegratorId::verlet_exp)->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_PaperStep, overdamped, mrf::IntegratorId::overdamped)->Unit(benchmark::kMicrosecond)->UseRealTime();
 
-void BM_PaperImplicitStep(benchmark::State& state, mrf::ContactLinearSolver solver) {
+void BM_PaperImplicitStep(benchmark::State& state, mrf::ContactFormulation formulation,
+                          mrf::ContactLinearSolver solver) {
   mrf::DemModel model = paper_model(mrf::IntegratorId::implicit);
   mrf::ImplicitOptions o;
+  o.formulation = formulation;
   o.solver = solver;
   model.set_implicit_options(o);
   const mrf::ImplicitCounters c0 = model.implicit_counters();
@@ -56,8 +58,12 @@ void BM_PaperImplicitStep(benchmark::State& state, mrf::ContactLinearSolver solv
   state.counters["rejected/step"] = static_cast<double>(c.rejected + c.newton_failures - c0.rejected - c0.newton_failures) / steps;
   state.counters["mean_dt_s"] = (model.time() - t0) / steps;
 }
-BENCHMARK_CAPTURE(BM_PaperImplicitStep, pcg, mrf::ContactLinearSolver::pcg)->Unit(benchmark::kMicrosecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_PaperImplicitStep, eigen_ldlt, mrf::ContactLinearSolver::eigen_ldlt)->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_PaperImplicitStep, dual, mrf::ContactFormulation::dual, mrf::ContactLinearSolver::pcg)
+    ->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_PaperImplicitStep, primal_pcg, mrf::ContactFormulation::primal, mrf::ContactLinearSolver::pcg)
+    ->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_PaperImplicitStep, primal_eigen_ldlt, mrf::ContactFormulation::primal,
+                  mrf::ContactLinearSolver::eigen_ldlt)->Unit(benchmark::kMicrosecond)->UseRealTime();
 
 void BM_PaperPairForces(benchmark::State& state) {
   mrf::DemModel model = paper_model(mrf::IntegratorId::verlet_exp);

@@ -4,12 +4,16 @@
 #include <cmath>
 
 #include "mrf/forces/hertz.hpp"
+#include "mrf/neighbors/cell_list.hpp"
 
 namespace mrf {
 
 namespace {
-Vec3 pair_vector(const ContactPair& c, const std::vector<Vec3>& x, const WallParticles& walls, const Box& box) {
-  return box.min_image(x[c.i] - (c.wall ? walls.x[c.k] : x[c.k]));
+Vec3 pair_vector(const ContactPair& c, const std::vector<Vec3>& x, const WallParticles& walls, const MinImageYZ& mi) {
+  Vec3 d = x[c.i] - (c.wall ? walls.x[c.k] : x[c.k]);
+  d.y() = mi.wrap_y(d.y());
+  d.z() = mi.wrap_z(d.z());
+  return d;
 }
 }  // namespace
 
@@ -93,6 +97,7 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
   pairs_ = &pairs;
   const std::size_t np = pairs.size();
   const double two_r = 2.0 * radius;
+  const MinImageYZ mi(box);
   lambda_.resize(np);
   n_.resize(np);
   comp_.resize(np);
@@ -101,37 +106,43 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
   s_.resize(y.size());
   // Warm start: the Hertz forces at x_start, along its normals.
   for (std::size_t c = 0; c < np; ++c) {
-    const Vec3 r = pair_vector(pairs[c], x_start, walls_start, box);
+    const Vec3 r = pair_vector(pairs[c], x_start, walls_start, mi);
     const double rn = r.norm();
     n_[c] = r / rn;
     lambda_[c] = hertz_force(two_r - rn, hertz_k);
   }
+  positions(pairs, b, dt_over_gamma, y);
   const double k23 = std::cbrt(hertz_k * hertz_k);  // k^{2/3}
   NewtonResult res;
   for (res.iterations = 1; res.iterations <= opt.max_iterations; ++res.iterations) {
-    positions(pairs, b, dt_over_gamma, y);
-    // Residuals at y, normals updated to y.
+    // Residuals at y, normals updated to y; y_next = b + (dt/gamma) G(y) lambda.
     act_.clear();
+    y_next_ = b;
     double worst = 0;
     for (std::size_t c = 0; c < np; ++c) {
-      const Vec3 r = pair_vector(pairs[c], y, walls, box);
+      const ContactPair& pc = pairs[c];
+      const Vec3 r = pair_vector(pc, y, walls, mi);
       const double rn = r.norm(), h = two_r - rn;
       n_[c] = r / rn;
       if (lambda_[c] <= 0 && h <= 0) continue;  // open and staying open
+      if (lambda_[c] > 0) {
+        const Vec3 f = (dt_over_gamma * lambda_[c]) * n_[c];
+        y_next_[pc.i] += f;
+        if (!pc.wall) y_next_[pc.k] -= f;
+      }
       const double h_lambda = std::cbrt(lambda_[c] * lambda_[c]) / k23;  // (lambda/k)^{2/3}
       phi_[c] = h - h_lambda;
       // Compliance slope: of the current force, or for a contact closing
       // from zero force, of the Hertz law at the overlap y gives it.
       comp_[c] = lambda_[c] > 0 ? 2.0 * h_lambda / (3.0 * lambda_[c]) : 1.0 / hertz_local_stiffness(h, hertz_k);
       act_.push_back(static_cast<std::uint32_t>(c));
-      if (std::abs(phi_[c]) > worst) worst = std::abs(phi_[c]), res.worst = pairs[c].i;
+      if (std::abs(phi_[c]) > worst) worst = std::abs(phi_[c]), res.worst = pc.i;
     }
     // y was placed with the normals of the last iterate; with the normals
-    // just updated, y - b - (dt/gamma) G(y) lambda = r_y. Newton on (y,
-    // lambda) with r_y eliminated: (A + C) dlambda = phi + G^T r_y, and the
-    // next y is b + (dt/gamma) G(y) (lambda + dlambda). Without the G^T r_y
-    // term the normals converge only linearly (30 % more iterations).
-    positions(pairs, b, dt_over_gamma, y_next_);
+    // just updated, y - y_next = r_y. Newton on (y, lambda) with r_y
+    // eliminated: (A + C) dlambda = phi + G^T r_y, and the next y is
+    // y_next + (dt/gamma) G(y) dlambda. Without the G^T r_y term the normals
+    // converge only linearly (30 % more iterations).
     for (auto c : act_) {
       const ContactPair& pc = pairs[c];
       const Vec3 ry = pc.wall ? Vec3(y[pc.i] - y_next_[pc.i])
@@ -146,9 +157,14 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
       return res;
     }
     res.linear_iterations += solve_cg(opt.linear_rtol, dt_over_gamma);
+    y.swap(y_next_);
     for (std::size_t a = 0; a < act_.size(); ++a) {
       const std::uint32_t c = act_[a];
-      lambda_[c] = std::max(0.0, lambda_[c] + d_[a]);
+      const double updated = std::max(0.0, lambda_[c] + d_[a]);
+      const Vec3 f = (dt_over_gamma * (updated - lambda_[c])) * n_[c];
+      lambda_[c] = updated;
+      y[pairs[c].i] += f;
+      if (!pairs[c].wall) y[pairs[c].k] -= f;
     }
   }
   res.iterations = opt.max_iterations;

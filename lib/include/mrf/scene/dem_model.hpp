@@ -23,9 +23,10 @@ namespace mrf {
 // the predictor x_n + dt v_n (v_n the slope of the previous step), i.e.
 // (dt/2)|v_{n+1} - v_n| ~ (dt^2/2)|x''|, the leading error term of IMEX Euler.
 // The contact step is solved for the forces (dual, contact_dual.hpp; the
-// default: 2.1x faster per strain unit on the small scene at 200 GPa, no
-// Newton failures) or for the positions (primal, implicit_contact.hpp; its
-// linear solver is `solver`). Both solve the same backward Euler equations.
+// default: 2.4x faster per strain unit than primal on the small scene at
+// 200 GPa, no Newton failures) or for the positions (primal,
+// implicit_contact.hpp; its linear solver is `solver`). Both solve the same
+// backward Euler equations (verification/integrate/test_contact_dual.cpp).
 enum class ContactFormulation { dual, primal };
 const char* to_string(ContactFormulation f);
 
