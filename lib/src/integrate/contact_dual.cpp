@@ -55,38 +55,19 @@ long ContactDual::solve_cg(double rtol, double dt_over_gamma) {
   const std::size_t m = act_.size();
   const auto& pairs = *pairs_;
   diag_.resize(m);
-  for (std::size_t a = 0; a < m; ++a)
-    diag_[a] = dt_over_gamma * (pairs[act_[a]].wall ? 1.0 : 2.0) + comp_[act_[a]];
-  auto dot = [](const std::vector<double>& u, const std::vector<double>& v) {
-    double s = 0;
-    for (std::size_t i = 0; i < u.size(); ++i) s += u[i] * v[i];
-    return s;
-  };
-  d_.assign(m, 0.0);
   r_.resize(m);
-  for (std::size_t a = 0; a < m; ++a) r_[a] = rhs_[act_[a]];
-  z_.resize(m);
-  for (std::size_t a = 0; a < m; ++a) z_[a] = r_[a] / diag_[a];
-  p_ = z_;
-  double rz = dot(r_, z_);
-  const double stop2 = rtol * rtol * dot(r_, r_);
-  const long max_it = 10 * static_cast<long>(m) + 10;
-  long it = 0;
-  while (dot(r_, r_) > stop2 && it < max_it) {
-    apply(p_, q_, dt_over_gamma);
-    const double alpha = rz / dot(p_, q_);
-    for (std::size_t a = 0; a < m; ++a) {
-      d_[a] += alpha * p_[a];
-      r_[a] -= alpha * q_[a];
-      z_[a] = r_[a] / diag_[a];
-    }
-    const double rz_new = dot(r_, z_);
-    const double beta = rz_new / rz;
-    rz = rz_new;
-    for (std::size_t a = 0; a < m; ++a) p_[a] = z_[a] + beta * p_[a];
-    ++it;
+  for (std::size_t a = 0; a < m; ++a) {
+    diag_[a] = dt_over_gamma * (pairs[act_[a]].wall ? 1.0 : 2.0) + comp_[act_[a]];
+    r_[a] = rhs_[act_[a]];
   }
-  return it;
+  return pcg(
+      r_, rtol, 10 * static_cast<long>(m) + 10,
+      [&](const std::vector<double>& p, std::vector<double>& out) { apply(p, out, dt_over_gamma); },
+      [&](const std::vector<double>& r, std::vector<double>& z) {
+        z.resize(r.size());
+        for (std::size_t a = 0; a < r.size(); ++a) z[a] = r[a] / diag_[a];
+      },
+      d_, cg_);
 }
 
 NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& b,

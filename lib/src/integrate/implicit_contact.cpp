@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "mrf/forces/hertz.hpp"
+#include "mrf/integrate/pcg.hpp"
 
 namespace mrf {
 
@@ -184,40 +185,12 @@ void ContactNewton::apply(const std::vector<Vec3>& p, std::vector<Vec3>& out) co
   }
 }
 
-namespace {
-double dot(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
-  double s = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) s += a[i].dot(b[i]);
-  return s;
-}
-}  // namespace
-
 // Preconditioned CG on J d = rhs over the particles in contact.
 long ContactNewton::solve_pcg(double rtol, bool sgs) {
-  const std::size_t n = active_.size();
-  d_.assign(n, Vec3::Zero());
-  r_ = rhs_;
-  precondition(r_, z_, sgs);
-  p_ = z_;
-  double rz = dot(r_, z_);
-  const double stop2 = rtol * rtol * dot(rhs_, rhs_);
-  const long max_it = 10 * static_cast<long>(3 * n) + 10;
-  long it = 0;
-  while (dot(r_, r_) > stop2 && it < max_it) {
-    apply(p_, q_);
-    const double alpha = rz / dot(p_, q_);
-    for (std::size_t a = 0; a < n; ++a) {
-      d_[a] += alpha * p_[a];
-      r_[a] -= alpha * q_[a];
-    }
-    precondition(r_, z_, sgs);
-    const double rz_new = dot(r_, z_);
-    const double beta = rz_new / rz;
-    rz = rz_new;
-    for (std::size_t a = 0; a < n; ++a) p_[a] = z_[a] + beta * p_[a];
-    ++it;
-  }
-  return it;
+  return pcg(
+      rhs_, rtol, 10 * static_cast<long>(3 * active_.size()) + 10,
+      [&](const std::vector<Vec3>& p, std::vector<Vec3>& out) { apply(p, out); },
+      [&](const std::vector<Vec3>& r, std::vector<Vec3>& z) { precondition(r, z, sgs); }, d_, cg_);
 }
 
 long ContactNewton::solve_eigen(ContactLinearSolver s, double rtol) {

@@ -21,6 +21,7 @@
 
 #include "mrf/box.hpp"
 #include "mrf/integrate/implicit_contact.hpp"
+#include "mrf/integrate/pcg.hpp"
 #include "mrf/state.hpp"
 
 namespace mrf {
@@ -52,7 +53,8 @@ class ContactDual {
   std::vector<double> lambda_, comp_, phi_, rhs_;
   std::vector<Vec3> n_;
   std::vector<std::uint32_t> act_;           // active pairs
-  std::vector<double> d_, r_, z_, p_, q_, diag_;  // CG on the active set (Jacobi preconditioner)
+  std::vector<double> d_, r_, diag_;           // CG on the active set: solution, right-hand side, Jacobi diagonal
+  PcgScratch<double> cg_;
   std::vector<Vec3> s_, y_next_;             // per particle: G p (scratch), positions with the new normals
   const std::vector<ContactPair>* pairs_ = nullptr;
 };

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "mrf/box.hpp"
+#include "mrf/integrate/pcg.hpp"
 #include "mrf/neighbors/verlet_list.hpp"
 #include "mrf/state.hpp"
 
@@ -112,7 +113,8 @@ class ContactNewton {
   std::vector<Block> blocks_;
   std::vector<Eigen::Matrix3d> diag_inv_;  // inverse diagonal blocks of J
   std::vector<std::uint32_t> adj_start_, adj_block_;  // free-free blocks of each active particle (CSR)
-  std::vector<Vec3> rhs_, d_, r_, z_, p_, q_;  // linear solve on the active set
+  std::vector<Vec3> rhs_, d_;                  // linear solve on the active set
+  PcgScratch<Vec3> cg_;
   std::vector<Vec3> step_, trial_;             // Newton direction, line-search trial point
 };
 
