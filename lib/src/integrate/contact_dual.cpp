@@ -29,8 +29,8 @@ void ContactDual::positions(const std::vector<ContactPair>& pairs, const std::ve
 }
 
 // (A + C) p on the active set: A = (dt/gamma) G^T G, C diagonal.
-void ContactDual::apply(const std::vector<double>& p, std::vector<double>& out, double dt_over_gamma) {
-  const auto& pairs = *pairs_;
+void ContactDual::apply(const std::vector<ContactPair>& pairs, const std::vector<double>& p, std::vector<double>& out,
+                        double dt_over_gamma) {
   for (std::size_t a = 0; a < act_.size(); ++a) {
     const ContactPair& c = pairs[act_[a]];
     s_[c.i].setZero();
@@ -51,9 +51,8 @@ void ContactDual::apply(const std::vector<double>& p, std::vector<double>& out, 
   }
 }
 
-long ContactDual::solve_cg(double rtol, double dt_over_gamma) {
+long ContactDual::solve_cg(const std::vector<ContactPair>& pairs, double rtol, double dt_over_gamma) {
   const std::size_t m = act_.size();
-  const auto& pairs = *pairs_;
   diag_.resize(m);
   r_.resize(m);
   for (std::size_t a = 0; a < m; ++a) {
@@ -62,7 +61,7 @@ long ContactDual::solve_cg(double rtol, double dt_over_gamma) {
   }
   return pcg(
       r_, rtol, 10 * static_cast<long>(m) + 10,
-      [&](const std::vector<double>& p, std::vector<double>& out) { apply(p, out, dt_over_gamma); },
+      [&](const std::vector<double>& p, std::vector<double>& out) { apply(pairs, p, out, dt_over_gamma); },
       [&](const std::vector<double>& r, std::vector<double>& z) {
         z.resize(r.size());
         for (std::size_t a = 0; a < r.size(); ++a) z[a] = r[a] / diag_[a];
@@ -75,14 +74,12 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
                                 const WallParticles& walls, const Box& box,
                                 double radius, double hertz_k, double dt_over_gamma, const DualOptions& opt,
                                 std::vector<Vec3>& y) {
-  pairs_ = &pairs;
   const std::size_t np = pairs.size();
   const double two_r = 2.0 * radius;
   const MinImageYZ mi(box);
   lambda_.resize(np);
   n_.resize(np);
   comp_.resize(np);
-  phi_.resize(np);
   rhs_.resize(np);
   s_.resize(y.size());
   // Warm start: the Hertz forces at x_start, along its normals.
@@ -112,12 +109,13 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
         if (!pc.wall) y_next_[pc.k] -= f;
       }
       const double h_lambda = std::cbrt(lambda_[c] * lambda_[c]) / k23;  // (lambda/k)^{2/3}
-      phi_[c] = h - h_lambda;
+      const double phi = h - h_lambda;  // the Hertz law's residual as an overlap
+      rhs_[c] = phi;
       // Compliance slope: of the current force, or for a contact closing
       // from zero force, of the Hertz law at the overlap y gives it.
       comp_[c] = lambda_[c] > 0 ? 2.0 * h_lambda / (3.0 * lambda_[c]) : 1.0 / hertz_local_stiffness(h, hertz_k);
       act_.push_back(static_cast<std::uint32_t>(c));
-      if (std::abs(phi_[c]) > worst) worst = std::abs(phi_[c]), res.worst = pc.i;
+      if (std::abs(phi) > worst) worst = std::abs(phi), res.worst = pc.i;
     }
     // y was placed with the normals of the last iterate; with the normals
     // just updated, y - y_next = r_y. Newton on (y, lambda) with r_y
@@ -128,7 +126,7 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
       const ContactPair& pc = pairs[c];
       const Vec3 ry = pc.wall ? Vec3(y[pc.i] - y_next_[pc.i])
                               : Vec3((y[pc.i] - y_next_[pc.i]) - (y[pc.k] - y_next_[pc.k]));
-      rhs_[c] = phi_[c] + n_[c].dot(ry);
+      rhs_[c] += n_[c].dot(ry);
       if (std::abs(rhs_[c]) > worst) worst = std::abs(rhs_[c]), res.worst = pc.i;
     }
     res.last_correction = worst;
@@ -137,7 +135,7 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
       res.converged = true;
       return res;
     }
-    res.linear_iterations += solve_cg(opt.linear_rtol, dt_over_gamma);
+    res.linear_iterations += solve_cg(pairs, opt.linear_rtol, dt_over_gamma);
     y.swap(y_next_);
     for (std::size_t a = 0; a < act_.size(); ++a) {
       const std::uint32_t c = act_[a];

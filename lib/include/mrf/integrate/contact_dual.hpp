@@ -6,8 +6,10 @@
 // unit vector from k to i at y). The Hertz law, written as a compliance,
 //   phi_c(lambda) = h_c(y(lambda)) - (lambda_c / k)^{2/3} = 0   (lambda_c > 0),
 //   lambda_c = 0 and h_c(y(lambda)) <= 0                        (open),
-// closes the system. Newton on phi with the normals frozen over one linear
-// solve: (A + C) dlambda = phi on the active contacts, A = (dt/gamma) G^T G (the
+// closes the system. Newton on (y, lambda) with y eliminated and the normals
+// frozen over one linear solve: (A + C) dlambda = phi + G^T r_y on the active
+// contacts (r_y: what moving the normals to the current y leaves of the
+// position equation), A = (dt/gamma) G^T G (the
 // Delassus operator of the mobility, exact and linear) and C the diagonal
 // compliance derivative (2/3) k^{-2/3} lambda^{-1/3}. In the position form the
 // stiff Hertz law is the Jacobian, whose stiffness changes on the scale of the
@@ -27,7 +29,7 @@
 namespace mrf {
 
 struct DualOptions {
-  double tol = 0;               // m: converged when every |phi_c| (overlap error) is below it
+  double tol = 0;               // m: converged when every |phi_c| and the normals' residual (overlaps) are below it
   int max_iterations = 30;
   double linear_rtol = 1e-1;    // relative residual of each CG solve
 };
@@ -45,18 +47,19 @@ class ContactDual {
  private:
   void positions(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& b, double dt_over_gamma,
                  std::vector<Vec3>& y) const;  // y = b + (dt/gamma) G lambda
-  void apply(const std::vector<double>& p, std::vector<double>& out, double dt_over_gamma);  // (A + C) p
-  long solve_cg(double rtol, double dt_over_gamma);
+  // (A + C) p on the active set
+  void apply(const std::vector<ContactPair>& pairs, const std::vector<double>& p, std::vector<double>& out,
+             double dt_over_gamma);
+  long solve_cg(const std::vector<ContactPair>& pairs, double rtol, double dt_over_gamma);
 
-  // Per candidate pair: force (N), compliance slope (m/N), overlap residual
-  // and Newton right-hand side (m), unit normal (k to i; frozen over a solve).
-  std::vector<double> lambda_, comp_, phi_, rhs_;
+  // Per candidate pair: force (N), compliance slope (m/N), Newton
+  // right-hand side (m), unit normal (k to i; frozen over a linear solve).
+  std::vector<double> lambda_, comp_, rhs_;
   std::vector<Vec3> n_;
   std::vector<std::uint32_t> act_;           // active pairs
   std::vector<double> d_, r_, diag_;           // CG on the active set: solution, right-hand side, Jacobi diagonal
   PcgScratch<double> cg_;
   std::vector<Vec3> s_, y_next_;             // per particle: G p (scratch), positions with the new normals
-  const std::vector<ContactPair>* pairs_ = nullptr;
 };
 
 }  // namespace mrf
