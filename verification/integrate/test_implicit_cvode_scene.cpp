@@ -1,6 +1,7 @@
 // The solver comparison of issue 7 on the small scene (Mn = 1e-2, Y = 200 GPa,
 // one strain unit, one thread): the library's implicit integrator (IMEX
-// Euler, Newton + block-Jacobi PCG, error-controlled) against SUNDIALS CVODE
+// Euler, contacts solved for their forces by Newton + Jacobi PCG,
+// error-controlled) against SUNDIALS CVODE
 // BDF (orders 1-5) with matrix-free SPGMR on the whole inertialess ODE:
 // Jacobian-vector products from the contact pair list (K = -dF_c/dx blocks,
 // the same as ContactNewton's, plus the shear), the dipole part left to the
@@ -204,7 +205,7 @@ TEST(ImplicitSolversSlow, CvodeBdfKrylovAgainstImexNewtonPcgOnTheSmallScene) {
                                       "drive.warmup_strain=0.3"};
   const LoadedScene s = load_scene(MRF_SOURCE_DIR "/experiments/scenes/small_dem_stokes.toml", sets);
   const RunSummary im = run_scene(s, RunOptions{"", true});
-  std::printf("IMEX Euler + Newton/PCG: %.2f s, %ld steps, %g Newton, %g CG, %g rejected; stress %.1f +- %.1f Pa\n",
+  std::printf("IMEX Euler, dual Newton/PCG: %.2f s, %ld steps, %g Newton, %g CG, %g rejected; stress %.1f +- %.1f Pa\n",
               im.wall_seconds, im.steps, im.extra.at("implicit_newton_iterations"),
               im.extra.at("implicit_linear_iterations"),
               im.extra.at("implicit_rejected_steps") + im.extra.at("implicit_newton_failures"), im.stress_total.mean,
