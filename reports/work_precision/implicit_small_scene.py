@@ -11,7 +11,8 @@ implicit_small_scene.csv and implicit_small_scene.png here:
     equal windows compare);
   * explicit soft-Y runs (verlet_exp at 0.2, 2, 20 GPa), explicit stiff-Y
     (200 GPa), implicit runs at 2, 20, 200 GPa (implicit_tol 0.01, the
-    default) and at 200 GPa with implicit_tol 0.005, 0.02, 0.05; six seeds;
+    default, order 2) and at 200 GPa with implicit_tol 0.005, 0.02, 0.05, and
+    order 1 at 0.01 and 0.02; six seeds;
   * error of the steady stress_total against the reference, with the block-
     averaging errors of both combined, against the wall time of the stepping
     normalised to one strain unit;
@@ -80,25 +81,27 @@ def main():
         t_exp = run(build, f"timing verlet_exp 200GPa rep {rep + 1}", one + ["numerics.integrator=verlet_exp"])
         t_imp = run(build, f"timing implicit 200GPa rep {rep + 1}", one + ["numerics.integrator=implicit"])
         timing.append((t_exp, t_imp))
-    # (group name, scheme, Y, implicit_tol)
-    configs = [(f"verlet_exp {y}", "verlet_exp", y, None) for y in ["0.2 GPa", "2 GPa", "20 GPa", "200 GPa"]] + \
-              [(f"implicit {y}", "implicit", y, "0.01") for y in ["2 GPa", "20 GPa", "200 GPa"]] + \
-              [(f"implicit 200 GPa tol {t}", "implicit", "200 GPa", t) for t in ["0.005", "0.02", "0.05"]]
+    # (group name, scheme, Y, implicit_tol, implicit_order); the implicit default is order 2, tol 0.01
+    configs = [(f"verlet_exp {y}", "verlet_exp", y, None, None) for y in ["0.2 GPa", "2 GPa", "20 GPa", "200 GPa"]] + \
+              [(f"implicit {y}", "implicit", y, "0.01", "2") for y in ["2 GPa", "20 GPa", "200 GPa"]] + \
+              [(f"implicit 200 GPa tol {t}", "implicit", "200 GPa", t, "2") for t in ["0.005", "0.02", "0.05"]] + \
+              [(f"implicit 200 GPa order 1 tol {t}", "implicit", "200 GPa", t, "1") for t in ["0.01", "0.02"]]
     groups = {}
-    for name, scheme, y, tol in configs:
+    for name, scheme, y, tol, order in configs:
         for seed in seeds:
             sets = drive + [f"numerics.integrator={scheme}", f'contact.youngs_modulus="{y}"', f"scene.seed={seed}"]
             if tol:
-                sets.append(f"numerics.implicit_tol={tol}")
+                sets += [f"numerics.implicit_tol={tol}", f"numerics.implicit_order={order}"]
             r = run(build, f"{name} seed {seed}", sets)
             r["seed"] = seed
             r["implicit_tol"] = tol or ""
             runs.append(r)
-            groups.setdefault((name, scheme, y, tol), []).append(r)
-    ref_key = ("verlet_exp 200 GPa", "verlet_exp", "200 GPa", None)
+            r["implicit_order"] = order or ""
+            groups.setdefault((name, scheme, y, tol, order), []).append(r)
+    ref_key = ("verlet_exp 200 GPa", "verlet_exp", "200 GPa", None, None)
     ref_m, ref_e, _ = mean_over_seeds(groups[ref_key])
 
-    keys = ["label", "integrator", "youngs_modulus", "implicit_tol", "seed", "strain", "warmup_strain",
+    keys = ["label", "integrator", "youngs_modulus", "implicit_tol", "implicit_order", "seed", "strain", "warmup_strain",
             "stress_total", "stress_total_err", "steps", "wall_seconds", "max_overlap_over_radius",
             "implicit_dt_mean", "implicit_rejected_steps", "implicit_newton_failures",
             "implicit_newton_iterations", "implicit_linear_iterations"]
@@ -111,18 +114,18 @@ def main():
     points = []
     with open(path_csv, "w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(["integrator", "youngs_modulus_Pa", "implicit_tol", "seeds", "stress_total_mean_Pa",
+        w.writerow(["integrator", "youngs_modulus_Pa", "implicit_tol", "implicit_order", "seeds", "stress_total_mean_Pa",
                     "stress_total_err_Pa", "seconds_per_strain", "signed_error_vs_reference_Pa", "error_bar_Pa",
                     "max_overlap_over_radius"])
-        for (name, scheme, y, tol), g in groups.items():
+        for (name, scheme, y, tol, order), g in groups.items():
             m, e, sec = mean_over_seeds(g)
-            is_ref = (name, scheme, y, tol) == ref_key
+            is_ref = (name, scheme, y, tol, order) == ref_key
             err = 0.0 if is_ref else m - ref_m
             bar = e if is_ref else math.hypot(e, ref_e)
             ov = max(r["max_overlap_over_radius"] for r in g)
-            w.writerow([scheme, g[0]["youngs_modulus"], tol or "", len(g), m, e, sec, err, bar, ov])
-            points.append((scheme, g[0]["youngs_modulus"], tol, m, e, sec, err, bar, is_ref))
-            print(f"{name:26s}: {m:.1f} +- {e:.1f} Pa, {sec:.2f} s per strain, error {err:+.1f} +- {bar:.1f}"
+            w.writerow([scheme, g[0]["youngs_modulus"], tol or "", order or "", len(g), m, e, sec, err, bar, ov])
+            points.append((scheme, g[0]["youngs_modulus"], tol, order, m, e, sec, err, bar, is_ref))
+            print(f"{name:32s}: {m:.1f} +- {e:.1f} Pa, {sec:.2f} s per strain, error {err:+.1f} +- {bar:.1f}"
                   f" Pa ({err / bar if bar else 0:+.2f} sigma), max overlap/R {ov:.3g}")
     ratios = [a["wall_seconds"] / b["wall_seconds"] for a, b in timing]
     print("timing, one strain unit at 200 GPa, side by side: " +
@@ -132,8 +135,10 @@ def main():
     fig, ax = plt.subplots(figsize=(5.4, 4.0), dpi=110)
     styles = {"verlet_exp": ("o", "tab:blue"), "implicit": ("s", "tab:red")}
     floor = 3.0
-    for scheme, y, tol, m, e, sec, err, bar, is_ref in points:
+    for scheme, y, tol, order, m, e, sec, err, bar, is_ref in points:
         mk, c = styles[scheme]
+        if order == "1":
+            mk, c = "^", "tab:green"
         if is_ref:
             ax.axvline(sec, color=c, ls="--", lw=1)
             ax.annotate("reference: explicit 200 GPa", (sec, floor * 1.2), fontsize=7, rotation=90, ha="right")
@@ -146,7 +151,8 @@ def main():
         ax.annotate(text, (sec, yv), textcoords="offset points", xytext=(4, 4), fontsize=7)
     ax.errorbar([], [], fmt="o", color="tab:blue", mfc="white", label="explicit verlet_exp, soft Y")
     ax.errorbar([], [], fmt="s", color="tab:red", mfc="white", label="implicit, soft Y")
-    ax.errorbar([], [], fmt="s", color="tab:red", label="implicit, Y = 200 GPa (implicit_tol)")
+    ax.errorbar([], [], fmt="s", color="tab:red", label="implicit BDF2, Y = 200 GPa (implicit_tol)")
+    ax.errorbar([], [], fmt="^", color="tab:green", label="implicit order 1, Y = 200 GPa")
     ax.axhline(ref_e, color="gray", ls=":", lw=1, label="reference error bar")
     ax.set_xscale("log")
     ax.set_yscale("log")

@@ -1,5 +1,5 @@
-// The implicit inertialess integrator (contacts backward Euler, dipole and
-// flow explicit; integrate/implicit_contact.hpp) against SUNDIALS CVODE
+// The implicit inertialess integrator (contacts backward Euler or BDF2,
+// dipole and flow explicit; scene/dem_model.hpp) against SUNDIALS CVODE
 // (BDF, dense direct solver, rtol 1e-11) on the same ODE
 //   dx_i/dt = u(x_i) + (F_dipole + F_hertz)_i / gamma,
 // with the wall spheres moving at (0, 0, gdot x_wall):
@@ -7,8 +7,8 @@
 //      Hertz contact (Y = 200 GPa);
 //  (b) a chain of ten spheres spanning the gap, released in a zigzag, settling
 //      and tilting under shear.
-// Fixed steps of the implicit scheme; the observed order is fitted (GSL) and
-// asserted. Steps are 10-300 times the explicit contact limits, where explicit
+// Fixed steps of the implicit scheme, order 1 (IMEX Euler) and 2 (IMEX BDF2);
+// the observed order is fitted (GSL) and asserted. Steps are 10-300 times the explicit contact limits, where explicit
 // schemes are unstable. (d) stability at 100x the explicit limits, overlap
 // bounded by the static Hertz overlap under the chain load.
 #include <cvode/cvode.h>
@@ -120,13 +120,14 @@ struct ImplicitRun {
   ImplicitCounters counters;
 };
 
-ImplicitRun run_implicit(const Problem& pb, double dt, const std::vector<double>& t_out) {
+ImplicitRun run_implicit(const Problem& pb, double dt, const std::vector<double>& t_out, int order) {
   ShearCell cell{pb.box, {pb.x0, Positions(pb.x0.size(), Vec3::Zero()), Positions(pb.x0.size(), Vec3::Zero())},
                  pb.walls};
   const auto start = std::chrono::steady_clock::now();
   DemModel m(std::move(cell), pb.p, IntegratorId::implicit, dt);
   ImplicitOptions o;
   o.fixed_step = true;
+  o.order = order;
   o.newton_tol_over_radius = 1e-10;  // far below the discretisation errors measured
   o.linear_rtol = 1e-12;
   m.set_implicit_options(o);
@@ -160,13 +161,14 @@ std::vector<double> grid(double step, double t_end) {
 }
 
 // Fixed-step runs at dt0 / 2^l against the reference; returns the fitted order.
-double observed_order(const Problem& pb, double dt0, int levels, double out_step, double t_end, const char* name) {
+double observed_order(const Problem& pb, double dt0, int levels, double out_step, double t_end, const char* name,
+                      int order) {
   const std::vector<double> t = grid(out_step, t_end);
   const std::vector<Positions> ref = cvode_reference(pb, t, 1e-11);
   std::vector<double> dt, err;
   for (int l = 0; l < levels; ++l) {
     dt.push_back(dt0 / std::pow(2.0, l));
-    const ImplicitRun run = run_implicit(pb, dt.back(), t);
+    const ImplicitRun run = run_implicit(pb, dt.back(), t, order);
     err.push_back(max_error(pb, run.x, ref));
     std::printf("%s dt %.3e  error %.4e m (%.3e R)  wall %.4f s  %ld steps  %ld Newton  %ld CG\n", name, dt.back(),
                 err.back(), err.back() / pb.p.radius, run.wall_s, run.steps, run.counters.newton_iterations,
@@ -194,7 +196,13 @@ TEST(ImplicitVsCvode, PairIntoHertzContactIsFirstOrder) {
                                                 hertz_overlap_under_load(pb.p.contact_force, pb.p.hertz_k));
   std::printf("explicit overdamped contact limit %.3e s\n", limit);
   ASSERT_GT(8e-8 / 8, 10 * limit);
-  EXPECT_NEAR(observed_order(pb, 8e-8, 4, 8e-8, 8e-6, "pair"), 1.0, 0.15);
+  EXPECT_NEAR(observed_order(pb, 8e-8, 4, 8e-8, 8e-6, "pair", 1), 1.0, 0.15);
+}
+
+TEST(ImplicitVsCvode, PairIntoHertzContactBdf2) {
+  const Problem pb = pair_problem();
+  const double order = observed_order(pb, 8e-8, 4, 8e-8, 8e-6, "pair BDF2", 2);
+  EXPECT_NEAR(order, 2.0, 0.2);
 }
 
 TEST(ImplicitVsCvode, PairComesToRestAtTheStaticOverlap) {
@@ -203,7 +211,7 @@ TEST(ImplicitVsCvode, PairComesToRestAtTheStaticOverlap) {
   const Problem pb = pair_problem();
   const std::vector<double> t{12e-6};
   const Positions ref = cvode_reference(pb, t, 1e-12)[0];
-  const ImplicitRun run = run_implicit(pb, 1e-7, t);
+  const ImplicitRun run = run_implicit(pb, 1e-7, t, 2);
   const double h_ref = 2 * pb.p.radius - (ref[1] - ref[0]).norm();
   const double h = 2 * pb.p.radius - (run.x[0][1] - run.x[0][0]).norm();
   std::printf("static overlap: implicit %.10e m, CVODE %.10e m\n", h, h_ref);
@@ -242,7 +250,19 @@ TEST(ImplicitVsCvode, ShearedTenSphereChainIsFirstOrder) {
   std::printf("explicit contact limits at the pair overlap: overdamped %.3e s, verlet_exp %.3e s\n",
               contact_limit_at_overlap(pb.p, IntegratorId::overdamped, h),
               contact_limit_at_overlap(pb.p, IntegratorId::verlet_exp, h));
-  EXPECT_NEAR(observed_order(pb, 2e-8, 4, 1e-7, 4e-6, "chain"), 1.0, 0.15);
+  EXPECT_NEAR(observed_order(pb, 2e-8, 4, 1e-7, 4e-6, "chain", 1), 1.0, 0.15);
+}
+
+// BDF2 on the chain: the Hertz force h^{3/2} has an unbounded second
+// derivative where a contact closes, and the chain's zigzag closes several,
+// so the observed order falls between 1 and 2 (1.45 +- 0.13 measured; the
+// single pair, with one closing, gives 1.92); the error is 8-19x below
+// order 1's at the same steps.
+TEST(ImplicitVsCvode, ShearedTenSphereChainBdf2) {
+  const Problem pb = chain_problem(2.7925e4, 22 - 0.002, 0.25);
+  const double order = observed_order(pb, 2e-8, 4, 1e-7, 4e-6, "chain BDF2", 2);
+  EXPECT_GT(order, 1.3);
+  EXPECT_LT(order, 2.2);
 }
 
 // ---- (d) stability far above the explicit contact limits, Y = 200 GPa.
@@ -269,18 +289,24 @@ TEST(ImplicitStability, ChainFarAboveTheExplicitLimitsStaysFiniteWithBoundedOver
   std::printf("dt = %.0f x the verlet_exp limit = %.0f x the overdamped limit\n", dt / limit_ve, dt / limit_od);
   ASSERT_GE(dt, 100 * limit_od);
   const std::vector<double> t{200 * dt};
-  const ImplicitRun run = run_implicit(pb, dt, t);
   const Positions ref = cvode_reference(pb, t, 1e-10)[0];
-  for (const Vec3& x : run.x[0]) ASSERT_TRUE(x.allFinite());
-  std::printf("dt %.3e s; max overlap %.4e m (pair %.4e, design %.4e); end error %.3e R\n", dt,
-              run.max_overlap, h_pair, h_design, max_error(pb, run.x, {ref}) / p.radius);
-  EXPECT_GT(run.max_overlap, h_pair);
-  EXPECT_LT(run.max_overlap, h_design);
   // Sharper: the middle contact of a straight chain of ten carries the pairs
   // across it within the cut-off 7R: 1 + 2/2^4 + 3/3^4 pair forces.
   const double h_chain = hertz_overlap_under_load((1 + 2 / 16.0 + 3 / 81.0) * p.contact_force, p.hertz_k);
-  EXPECT_NEAR(run.max_overlap / h_chain, 1.0, 0.01) << "static chain overlap " << h_chain;
-  EXPECT_LT(max_error(pb, run.x, {ref}), 1e-3 * p.radius);  // settled: both at the same equilibrium
+  for (int order : {1, 2}) {
+    const ImplicitRun run = run_implicit(pb, dt, t, order);
+    for (const Vec3& x : run.x[0]) ASSERT_TRUE(x.allFinite());
+    std::printf("order %d, dt %.3e s; max overlap %.4e m (pair %.4e, static chain %.4e, design %.4e); end error %.3e R\n",
+                order, dt, run.max_overlap, h_pair, h_chain, h_design, max_error(pb, run.x, {ref}) / p.radius);
+    EXPECT_GT(run.max_overlap, h_pair) << order;
+    EXPECT_LT(run.max_overlap, h_design) << order;
+    // Backward Euler approaches the static overlap from below; BDF2 is not
+    // monotone and overshoots it in the closing transient (9 % here).
+    if (order == 1) {
+      EXPECT_NEAR(run.max_overlap / h_chain, 1.0, 0.01) << "static chain overlap " << h_chain;
+    }
+    EXPECT_LT(max_error(pb, run.x, {ref}), 1e-3 * p.radius) << order;  // settled: both at the same equilibrium
+  }
 }
 
 // A fixed step far beyond what the explicit dipole force and the contact
@@ -289,7 +315,7 @@ TEST(ImplicitStability, ChainFarAboveTheExplicitLimitsStaysFiniteWithBoundedOver
 TEST(ImplicitStability, OversizedFixedStepStopsWithAClearError) {
   const Problem pb = chain_problem(2.7925e4, 22 - 0.002, 0.25);
   try {
-    run_implicit(pb, 1e-5, {1e-5});
+    run_implicit(pb, 1e-5, {1e-5}, 2);
     ADD_FAILURE() << "no NumericalError";
   } catch (const NumericalError& e) {
     const std::string msg = e.what();

@@ -25,10 +25,17 @@ LoadedScene small(const std::vector<std::string>& sets) {
   return load_scene(MRF_SOURCE_DIR "/experiments/scenes/small_dem_stokes.toml", all);
 }
 
+// At Mn 1e-2 the implicit bound (the wall motion the contact search allows)
+// is 6x even the soft explicit limit; at Mn 0.1 the walls are 10x faster.
 TEST(ImplicitChoice, AutoPrefersImplicitAtTheRealModulusAndExplicitAtASoftOne) {
-  for (const auto& [youngs, want] : {std::pair{"\"200 GPa\"", IntegratorId::implicit},
-                                     std::pair{"\"0.2 GPa\"", IntegratorId::verlet_exp}}) {
-    const LoadedScene s = small({std::string("contact.youngs_modulus=") + youngs});
+  struct Case {
+    const char* youngs;
+    const char* mason;
+    IntegratorId want;
+  };
+  for (const auto& [youngs, mason, want] : {Case{"\"200 GPa\"", "0.01", IntegratorId::implicit},
+                                            Case{"\"0.2 GPa\"", "0.1", IntegratorId::verlet_exp}}) {
+    const LoadedScene s = small({std::string("contact.youngs_modulus=") + youngs, std::string("drive.mason=") + mason});
     const DemParams p = dem_params(s.config);
     const TimeStepChoice t = choose_time_step(s, p);
     EXPECT_EQ(t.scheme, want) << youngs;
@@ -44,7 +51,7 @@ TEST(ImplicitChoice, AutoPrefersImplicitAtTheRealModulusAndExplicitAtASoftOne) {
 }
 
 TEST(ImplicitRun, ShortRunReportsCountsAndBoundedSteps) {
-  const LoadedScene s = small({"drive.strain=0.35", "drive.warmup_strain=0.1", "numerics.integrator=implicit"});
+  const LoadedScene s = small({"drive.strain=0.6", "drive.warmup_strain=0.1", "numerics.integrator=implicit"});
   const RunSummary r = run_scene(s, RunOptions{"", true});
   const DemParams p = dem_params(s.config);
   const double explicit_dt = smallest(dem_limits(p, s.config, IntegratorId::verlet_exp));
@@ -56,7 +63,7 @@ TEST(ImplicitRun, ShortRunReportsCountsAndBoundedSteps) {
               r.extra.at("implicit_rejected_steps"), r.extra.at("implicit_newton_iterations"),
               r.extra.at("implicit_linear_iterations"), r.wall_seconds);
   EXPECT_EQ(r.integrator, "implicit");
-  EXPECT_NEAR(r.extra.at("implicit_dt_mean") * static_cast<double>(r.steps) * r.shear_rate, 0.35, 1e-9);
+  EXPECT_NEAR(r.extra.at("implicit_dt_mean") * static_cast<double>(r.steps) * r.shear_rate, 0.6, 1e-9);
   EXPECT_LE(r.extra.at("implicit_dt_max"), r.dt * (1 + 1e-12));  // the bound holds
   EXPECT_GT(r.extra.at("implicit_dt_mean"), 5 * explicit_dt);
   EXPECT_GE(r.extra.at("implicit_newton_iterations"), static_cast<double>(r.steps));

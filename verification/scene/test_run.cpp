@@ -570,9 +570,9 @@ TEST(RunIntegratorChoice, AutoPicksTheSchemeWhoseBindingLimitIsLargest) {
 }
 
 TEST(RunIntegratorChoice, TinyDensityRunReportsTheSchemeOfTheRule) {
-  const std::vector<std::string> set = {"particles.density=7.8", "contact.youngs_modulus=\"0.1 GPa\"",
-                                        "numerics.integrator=auto",
-                                        "drive.strain=0.08", "drive.warmup_strain=0.02",
+  const std::vector<std::string> set = {"particles.density=7.8", "contact.youngs_modulus=\"0.45 GPa\"",
+                                        "numerics.integrator=auto", "drive.mason=0.1",
+                                        "drive.strain=0.5", "drive.warmup_strain=0.1",
                                         "output.every=0"};
   const LoadedScene s = scene(set);
   const DemParams p = dem_params(s.config);

@@ -101,6 +101,7 @@ const KeySpec k_keys[] = {
     {"numerics.skin", &C::skin, Dim::length, Need::optional, k_nonneg},
     {"numerics.dt_safety", &C::dt_safety, Dim::none, Need::optional, {0, 1, true, false}},
     {"numerics.implicit_tol", &C::implicit_tol, Dim::none, Need::optional, {0, 1, true, false}},
+    {"numerics.implicit_order", &C::implicit_order, Dim::none, Need::optional, k_any},
     {"numerics.threads", &C::threads, Dim::none, Need::optional, k_any},
     {"output.every", &C::every, Dim::none, Need::optional, k_any},
     {"output.frames", &C::frames, Dim::none, Need::optional, k_any},
@@ -390,6 +391,9 @@ const Rule k_rules[] = {
      }},
     {"drive.warmup_strain", [](const C& c, const Given&) {
        return unless(c.warmup_strain < c.strain, "must be < drive.strain = " + num(c.strain));
+     }},
+    {"numerics.implicit_order", [](const C& c, const Given&) {
+       return unless(c.implicit_order == 1 || c.implicit_order == 2, "must be 1 or 2");
      }},
 };
 

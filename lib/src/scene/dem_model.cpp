@@ -22,6 +22,10 @@ namespace {
 constexpr double k_implicit_skin_over_radius = 0.4;
 // Skin of the near list of contact candidates (a refresh scans the dipole list).
 constexpr double k_near_skin_over_radius = 1.0;
+// Milne's device for BDF2 against a quadratic extrapolation (equal steps):
+// BDF2's local error is -(2/9) h^3 x''', the extrapolation's +h^3 x''', so
+// the error is (2/9)/(1 + 2/9) = 2/11 of their difference.
+constexpr double k_bdf2_error_constant = 2.0 / 11.0;
 // A step shorter than this fraction of the largest allowed one is a failure.
 constexpr double k_dt_floor = 1e-7;
 }  // namespace
@@ -75,19 +79,35 @@ void DemModel::step() {
     exp_verlet_correct(f.x, f.v, f.f, w_, p_.tau_p, p_.gamma, p_.shear_rate, dt_);
 }
 
-// One try of an IMEX Euler step of length dt from x0_ (explicit drift in w_):
-// Newton for y = b + (dt/gamma) F_c(y), b = x_n + dt w, walls at t_{n+1}.
-// Leaves y in free.x; returns the Newton result, the error estimate (half the
-// largest distance from the predictor x_n + dt v_n) and the largest displacement.
+namespace {
+// x moved to the periodic image nearest `ref` (positions are wrapped each step).
+Vec3 image_near(const Vec3& ref, const Vec3& x, const Box& box) { return ref - box.min_image(ref - x); }
+}  // namespace
+
+// One try of an implicit step of length dt from x0_ (explicit drift in w_):
+// Newton for y = b + (c dt/gamma) F_c(y), walls at t_{n+1}; IMEX Euler:
+// b = x_n + dt w_n, c = 1; BDF2 with omega = dt/dt_{n-1}:
+//   b = a1 x_n - a2 x_{n-1} + c dt ((1 + omega) w_n - omega w_{n-1}),
+//   a1 = (1+omega)^2/(1+2 omega), a2 = omega^2/(1+2 omega), c = (1+omega)/(1+2 omega).
+// Leaves y in free.x; returns the Newton result, the error estimate and the
+// largest displacement.
 DemModel::Attempt DemModel::attempt(double dt, const NewtonOptions& nopt) {
   auto& f = cell_.free;
   const std::size_t n = f.size();
-  const double dt_over_gamma = dt / p_.gamma;
+  const bool bdf2 = opt_.order == 2 && history_ >= 1;
+  const double om = dt / dt_;
+  const double c = bdf2 ? (1 + om) / (1 + 2 * om) : 1.0;
+  const double dt_over_gamma = c * dt / p_.gamma;
   b_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    b_[i] = x0_[i] + dt * w_[i];
-    f.x[i] = x0_[i] + dt * f.v[i];  // predictor
+  if (bdf2) {
+    const double a1 = (1 + om) * (1 + om) / (1 + 2 * om), a2 = om * om / (1 + 2 * om);
+    for (std::size_t i = 0; i < n; ++i)
+      b_[i] = a1 * x0_[i] - a2 * image_near(x0_[i], x_prev_[i], cell_.box) +
+              c * dt * ((1 + om) * w_[i] - om * w_prev_[i]);
+  } else {
+    for (std::size_t i = 0; i < n; ++i) b_[i] = x0_[i] + dt * w_[i];
   }
+  for (std::size_t i = 0; i < n; ++i) f.x[i] = x0_[i] + dt * f.v[i];  // predictor
   cell_.walls.x = walls0_.x;
   move_walls(cell_.walls, p_.shear_rate, dt);
   Attempt a;
@@ -108,16 +128,33 @@ DemModel::Attempt DemModel::attempt(double dt, const NewtonOptions& nopt) {
   }
   counters_.newton_iterations += a.newton.iterations;
   counters_.linear_iterations += a.newton.linear_iterations;
+  // Error: order 1, half the distance from the linear predictor x_n + dt v_n
+  // ((dt/2)|v_{n+1} - v_n|); order 2, Milne's device on the quadratic through
+  // x_{n-2}, x_{n-1}, x_n (Lagrange weights l0, l1, l2 at t_{n+1}).
+  const bool quadratic = opt_.order == 2 && history_ >= 2;
+  double l0 = 0, l1 = 0, l2 = 0;
+  if (quadratic) {
+    const double t0 = -(dt_ + dt_prev2_), t1 = -dt_;
+    l0 = (dt - t1) * dt / ((t0 - t1) * t0);
+    l1 = (dt - t0) * dt / ((t1 - t0) * t1);
+    l2 = (dt - t0) * (dt - t1) / (t0 * t1);
+  }
   for (std::size_t i = 0; i < n; ++i) {
-    a.error = std::max(a.error, 0.5 * (f.x[i] - x0_[i] - dt * f.v[i]).norm());
+    if (quadratic) {
+      const Vec3 pred = l0 * image_near(x0_[i], x_prev2_[i], cell_.box) +
+                        l1 * image_near(x0_[i], x_prev_[i], cell_.box) + l2 * x0_[i];
+      a.error = std::max(a.error, k_bdf2_error_constant * (f.x[i] - pred).norm());
+    } else {
+      a.error = std::max(a.error, 0.5 * (f.x[i] - x0_[i] - dt * f.v[i]).norm());
+    }
     const double d = (f.x[i] - x0_[i]).norm();
     if (d > a.displacement) a.displacement = d, a.moved = static_cast<std::uint32_t>(i);
   }
   return a;
 }
 
-// IMEX Euler (REFERENCE §3, contacts implicit), one accepted step:
-//   y = x_n + dt (u(x_n) + F_nc(x_n)/gamma) + (dt/gamma) F_c(y),
+// IMEX Euler or BDF2 (REFERENCE §3, contacts implicit), one accepted step:
+//   y = x_n + dt (u(x_n) + F_nc(x_n)/gamma) + (dt/gamma) F_c(y)   (order 1; order 2: attempt()),
 // error-controlled (ImplicitOptions): a step is retried shorter when Newton
 // fails (dt/4), a particle or the walls move more than half the contact
 // margin (dt/2), or the error estimate exceeds the tolerance.
@@ -157,13 +194,22 @@ void DemModel::implicit_step() {
                                      std::to_string(a.newton.worst));
       throw NumericalError(m.str());
     }
+    // The local error scales as dt^2 (order 1) or dt^3 (order 2).
+    const double exponent = opt_.order == 2 && history_ >= 2 ? -1.0 / 3.0 : -0.5;
     if (a.newton.converged && !too_far && (ratio <= 1.0 || opt_.fixed_step)) {
       for (std::size_t i = 0; i < f.size(); ++i) f.v[i] = (f.x[i] - x0_[i]) / dt;
-      dt_try_ = std::min(dt_max_, dt * std::min(2.0, 0.9 / std::sqrt(std::max(ratio, 1e-6))));
+      dt_try_ = std::min(dt_max_, dt * std::min(2.0, 0.9 * std::pow(std::max(ratio, 1e-6), exponent)));
+      if (opt_.order == 2) {
+        x_prev2_.swap(x_prev_);
+        x_prev_ = x0_;
+        w_prev_ = w_;
+        dt_prev2_ = dt_;
+        history_ = std::min(history_ + 1, 2);
+      }
       break;
     }
     ++(a.newton.converged ? counters_.rejected : counters_.newton_failures);
-    dt *= !a.newton.converged ? 0.25 : too_far ? 0.5 : std::max(0.2, 0.9 / std::sqrt(ratio));
+    dt *= !a.newton.converged ? 0.25 : too_far ? 0.5 : std::max(0.2, 0.9 * std::pow(ratio, exponent));
     if (!(dt >= dt_floor)) {
       std::ostringstream m;
       m << "implicit step failed at step " << steps_ << " (t = " << time_ << " s): the step size fell to " << dt

@@ -149,6 +149,7 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
   DemModel model(std::move(cell), p, ts.scheme, ts.dt);
   ImplicitOptions implicit_opt;
   implicit_opt.tol_over_radius = c.implicit_tol;
+  implicit_opt.order = c.implicit_order;
   model.set_implicit_options(implicit_opt);
   // The implicit scheme chooses its steps: it runs to the end time and writes
   // a row every `every` steps of its largest dt, i.e. by strain interval.

@@ -162,7 +162,7 @@ std::string scene_fingerprint(const SceneConfig& c) {
     out += buf;
   }
   out += std::string(to_string(c.model)) + ";" + to_string(c.integrator) + ";" + std::to_string(c.seed) + ";" +
-         std::to_string(c.threads) + ";" + std::to_string(c.every) + ";" + std::to_string(c.frames);
+         std::to_string(c.threads) + ";" + std::to_string(c.implicit_order) + ";" + std::to_string(c.every) + ";" + std::to_string(c.frames);
   return out;
 }
 

@@ -48,6 +48,7 @@ struct SceneConfig {
   double skin = 0;             // m, Verlet skin; 0 = 0.2 radius
   double dt_safety = 0.5;      // fraction of the smallest stability limit used by automatic dt
   double implicit_tol = 1e-2;  // implicit scheme: largest local error per step / radius
+  int implicit_order = 2;      // implicit scheme: 1 (IMEX Euler) or 2 (IMEX BDF2)
   int threads = 0;             // OpenMP threads; 0 = OMP default
   // [output]
   int every = 0;               // steps between time-series rows; 0 = about 2000 rows per run

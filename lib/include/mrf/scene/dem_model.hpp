@@ -30,7 +30,14 @@ namespace mrf {
 enum class ContactFormulation { dual, primal };
 const char* to_string(ContactFormulation f);
 
+// Order 2 is IMEX BDF2 (SBDF2) with variable steps: backward differentiation
+// of order 2 for the contacts, the explicit drift extrapolated linearly from
+// the last two steps, and the local error estimated by Milne's device from a
+// quadratic extrapolation of the last three positions,
+// err = (2/11) |y - y_pred| (the constant of equal steps); the first two
+// steps of a run are order 1.
 struct ImplicitOptions {
+  int order = 2;                         // 1: IMEX Euler; 2: IMEX BDF2
   double tol_over_radius = 1e-2;         // largest local error per step / R
   double newton_tol_over_radius = 1e-6;  // Newton converged: largest correction (primal) or overlap residual (dual) / R
   double linear_rtol = 1e-1;             // relative residual of each linear solve (inexact Newton)
@@ -118,6 +125,11 @@ class DemModel {
   double near_reach_ = 0;
   std::vector<Vec3> x0_, b_, fc_;
   WallParticles walls0_;
+  // order 2: positions and explicit drift of the last accepted steps,
+  // the step before dt_ (s), and how many accepted steps they hold (<= 2)
+  std::vector<Vec3> x_prev_, x_prev2_, w_prev_;
+  double dt_prev2_ = 0;
+  int history_ = 0;
 };
 
 // The DEM part of a checkpoint, shared by DemModel and CoupledModel: free
