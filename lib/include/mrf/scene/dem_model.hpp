@@ -1,10 +1,11 @@
 // The one-way DEM-Stokes model (`dem_stokes`): free magnetic spheres, wall
-// spheres (optional), imposed Couette flow, and one of two integrators:
+// spheres (optional), imposed Couette flow, and one of three integrators:
 //  verlet_exp  exponential velocity Verlet: drag exact over the step,
 //              forces linear in time (integrate/steps.hpp)
 //  overdamped  v = u(x) + F/gamma, x += v dt   (inertialess, first order)
-//  implicit    inertialess, Hertz contacts backward Euler, dipole and flow
-//              explicit (integrate/implicit_contact.hpp); the step size is
+//  implicit    inertialess, Hertz contacts implicit (BDF2, or backward Euler
+//              at order 1), dipole and flow explicit; each step solved for the
+//              contact forces (integrate/contact_dual.hpp); the step size is
 //              chosen from a local error estimate, up to the dt given.
 #pragma once
 #include <limits>
