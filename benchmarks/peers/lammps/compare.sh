@@ -207,7 +207,9 @@ for ((r = 1; r <= reps; r++)); do
     if [[ "$code" == mrf ]]; then
       echo "  [b] rep $r: mrf to strain $strain at its automatic dt (verlet_exp, then implicit)"
       mrf_run "b_mrf_$r" "$strain" "$window"
-      mrf_int=implicit mrf_run "b_mrf_implicit_$r" "$strain" "$window"
+      # no warm-up for the implicit run: its rows come by strain interval (one per largest step),
+      # and (c) takes the window from its time series anyway
+      mrf_int=implicit mrf_run "b_mrf_implicit_$r" "$strain" 0
     else
       echo "  [b] rep $r: LAMMPS to strain $strain: $nb_lmp steps at dt = $dt_lmp s"
       lmp_run "b_lmp_$r" "$nb_lmp" "$dt_lmp" 10 "$nb_lmp"
