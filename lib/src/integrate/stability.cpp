@@ -98,7 +98,9 @@ std::vector<StabilityLimit> dem_limits(const DemParams& p, const SceneConfig& c,
     // it from above. Explicit dipoles: the transverse (aligning) stiffness of
     // a head-to-tail pair at contact is F/(2R), and the alternating mode of a
     // chain relaxes at 4 (F/2R)/gamma, so explicit Euler on it is stable for
-    // dt < gamma R / F. Contact candidates: a step must not move the walls by
+    // dt < gamma R / F. (BDF2's extrapolated explicit part has a smaller
+    // stability interval, about half; on the small and paper scenes this
+    // limit is still 6-12x above the contact-margin bound, which binds.) Contact candidates: a step must not move the walls by
     // more than half the candidate margin (dem_model.cpp), or a contact could
     // be missed.
     if (p.contact_force > 0)
