@@ -72,7 +72,7 @@ long ContactDual::solve_cg(const std::vector<ContactPair>& pairs, double rtol, d
 NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& b,
                                 const std::vector<Vec3>& x_start, const WallParticles& walls_start,
                                 const WallParticles& walls, const Box& box,
-                                double radius, double hertz_k, double dt_over_gamma, const DualOptions& opt,
+                                double radius, double hertz_k, double dt_over_gamma, const NewtonOptions& opt,
                                 std::vector<Vec3>& y) {
   const std::size_t np = pairs.size();
   const double two_r = 2.0 * radius;

@@ -107,16 +107,15 @@ DemModel::Attempt DemModel::attempt(double dt, const NewtonOptions& nopt) {
   } else {
     for (std::size_t i = 0; i < n; ++i) b_[i] = x0_[i] + dt * w_[i];
   }
-  for (std::size_t i = 0; i < n; ++i) f.x[i] = x0_[i] + dt * f.v[i];  // predictor
   cell_.walls.x = walls0_.x;
   move_walls(cell_.walls, p_.shear_rate, dt);
   Attempt a;
   if (opt_.formulation == ContactFormulation::dual) {
     // Starts from the contact forces at x_n (walls at t_n).
-    const DualOptions dopt{nopt.tol, nopt.max_iterations, nopt.linear_rtol};
     a.newton = dual_.solve(candidates_, b_, x0_, walls0_, cell_.walls, cell_.box, p_.radius, p_.hertz_k, dt_over_gamma,
-                           dopt, f.x);
+                           nopt, f.x);
   } else {
+    for (std::size_t i = 0; i < n; ++i) f.x[i] = x0_[i] + dt * f.v[i];  // predictor
     // Newton starts from the predictor or from x_n, whichever is lower in the
     // merit function: after a sudden change (a contact made or broken) the
     // extrapolated slope can throw the predictor far off.

@@ -28,21 +28,17 @@
 
 namespace mrf {
 
-struct DualOptions {
-  double tol = 0;               // m: converged when every |phi_c| and the normals' residual (overlaps) are below it
-  int max_iterations = 30;
-  double linear_rtol = 1e-1;    // relative residual of each CG solve
-};
 
 class ContactDual {
  public:
   // Solves the step for y (out), starting from the forces of the pairs at
   // positions x_start with the walls at walls_start (the last step's contact
-  // forces); `walls` at the end of the step. dt_over_gamma in s/kg.
+  // forces); `walls` at the end of the step. dt_over_gamma in s/kg. opt.tol
+  // (m) bounds every overlap residual at convergence; opt.solver is unused.
   NewtonResult solve(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& b,
                      const std::vector<Vec3>& x_start, const WallParticles& walls_start, const WallParticles& walls,
                      const Box& box, double radius,
-                     double hertz_k, double dt_over_gamma, const DualOptions& opt, std::vector<Vec3>& y);
+                     double hertz_k, double dt_over_gamma, const NewtonOptions& opt, std::vector<Vec3>& y);
 
  private:
   void positions(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& b, double dt_over_gamma,
