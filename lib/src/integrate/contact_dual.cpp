@@ -17,20 +17,29 @@ Vec3 pair_vector(const ContactPair& c, const std::vector<Vec3>& x, const WallPar
 }
 }  // namespace
 
-void ContactDual::positions(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& b, double dt_over_gamma,
-                            std::vector<Vec3>& y) const {
+void ContactDual::positions(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& b,
+                            const std::vector<double>& mob, std::vector<Vec3>& y) const {
   y = b;
   for (std::size_t c = 0; c < pairs.size(); ++c) {
     if (lambda_[c] <= 0) continue;
-    const Vec3 f = (dt_over_gamma * lambda_[c]) * n_[c];
-    y[pairs[c].i] += f;
-    if (!pairs[c].wall) y[pairs[c].k] -= f;
+    const Vec3 f = lambda_[c] * n_[c];
+    y[pairs[c].i] += mob[pairs[c].i] * f;
+    if (!pairs[c].wall) y[pairs[c].k] -= mob[pairs[c].k] * f;
   }
 }
 
-// (A + C) p on the active set: A = (dt/gamma) G^T G, C diagonal.
+void ContactDual::add_forces(const std::vector<ContactPair>& pairs, std::vector<Vec3>& f) const {
+  for (std::size_t c = 0; c < pairs.size() && c < lambda_.size(); ++c) {
+    if (lambda_[c] <= 0) continue;
+    const Vec3 g = lambda_[c] * n_[c];
+    f[pairs[c].i] += g;
+    if (!pairs[c].wall) f[pairs[c].k] -= g;
+  }
+}
+
+// (A + C) p on the active set: A = G^T diag(mob) G, C diagonal.
 void ContactDual::apply(const std::vector<ContactPair>& pairs, const std::vector<double>& p, std::vector<double>& out,
-                        double dt_over_gamma) {
+                        const std::vector<double>& mob) {
   for (std::size_t a = 0; a < act_.size(); ++a) {
     const ContactPair& c = pairs[act_[a]];
     s_[c.i].setZero();
@@ -39,29 +48,30 @@ void ContactDual::apply(const std::vector<ContactPair>& pairs, const std::vector
   for (std::size_t a = 0; a < act_.size(); ++a) {
     const ContactPair& c = pairs[act_[a]];
     const Vec3 g = p[a] * n_[act_[a]];
-    s_[c.i] += g;
-    if (!c.wall) s_[c.k] -= g;
+    s_[c.i] += mob[c.i] * g;
+    if (!c.wall) s_[c.k] -= mob[c.k] * g;
   }
   out.resize(act_.size());
   for (std::size_t a = 0; a < act_.size(); ++a) {
     const std::uint32_t e = act_[a];
     const ContactPair& c = pairs[e];
     const Vec3 rel = c.wall ? s_[c.i] : Vec3(s_[c.i] - s_[c.k]);
-    out[a] = dt_over_gamma * n_[e].dot(rel) + comp_[e] * p[a];
+    out[a] = n_[e].dot(rel) + comp_[e] * p[a];
   }
 }
 
-long ContactDual::solve_cg(const std::vector<ContactPair>& pairs, double rtol, double dt_over_gamma) {
+long ContactDual::solve_cg(const std::vector<ContactPair>& pairs, double rtol, const std::vector<double>& mob) {
   const std::size_t m = act_.size();
   diag_.resize(m);
   r_.resize(m);
   for (std::size_t a = 0; a < m; ++a) {
-    diag_[a] = dt_over_gamma * (pairs[act_[a]].wall ? 1.0 : 2.0) + comp_[act_[a]];
+    const ContactPair& c = pairs[act_[a]];
+    diag_[a] = mob[c.i] + (c.wall ? 0.0 : mob[c.k]) + comp_[act_[a]];
     r_[a] = rhs_[act_[a]];
   }
   return pcg(
       r_, rtol, 10 * static_cast<long>(m) + 10,
-      [&](const std::vector<double>& p, std::vector<double>& out) { apply(pairs, p, out, dt_over_gamma); },
+      [&](const std::vector<double>& p, std::vector<double>& out) { apply(pairs, p, out, mob); },
       [&](const std::vector<double>& r, std::vector<double>& z) {
         z.resize(r.size());
         for (std::size_t a = 0; a < r.size(); ++a) z[a] = r[a] / diag_[a];
@@ -72,8 +82,8 @@ long ContactDual::solve_cg(const std::vector<ContactPair>& pairs, double rtol, d
 NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& b,
                                 const std::vector<Vec3>& x_start, const WallParticles& walls_start,
                                 const WallParticles& walls, const Box& box,
-                                double radius, double hertz_k, double dt_over_gamma, const NewtonOptions& opt,
-                                std::vector<Vec3>& y) {
+                                double radius, double hertz_k, const std::vector<double>& mob,
+                                const NewtonOptions& opt, std::vector<Vec3>& y) {
   const std::size_t np = pairs.size();
   const double two_r = 2.0 * radius;
   const MinImageYZ mi(box);
@@ -89,11 +99,11 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
     n_[c] = r / rn;
     lambda_[c] = hertz_force(two_r - rn, hertz_k);
   }
-  positions(pairs, b, dt_over_gamma, y);
+  positions(pairs, b, mob, y);
   const double k23 = std::cbrt(hertz_k * hertz_k);  // k^{2/3}
   NewtonResult res;
   for (res.iterations = 1; res.iterations <= opt.max_iterations; ++res.iterations) {
-    // Residuals at y, normals updated to y; y_next = b + (dt/gamma) G(y) lambda.
+    // Residuals at y, normals updated to y; y_next = b + M G(y) lambda.
     act_.clear();
     y_next_ = b;
     double worst = 0;
@@ -104,9 +114,9 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
       n_[c] = r / rn;
       if (lambda_[c] <= 0 && h <= 0) continue;  // open and staying open
       if (lambda_[c] > 0) {
-        const Vec3 f = (dt_over_gamma * lambda_[c]) * n_[c];
-        y_next_[pc.i] += f;
-        if (!pc.wall) y_next_[pc.k] -= f;
+        const Vec3 f = lambda_[c] * n_[c];
+        y_next_[pc.i] += mob[pc.i] * f;
+        if (!pc.wall) y_next_[pc.k] -= mob[pc.k] * f;
       }
       const double h_lambda = std::cbrt(lambda_[c] * lambda_[c]) / k23;  // (lambda/k)^{2/3}
       const double phi = h - h_lambda;  // the Hertz law's residual as an overlap
@@ -120,7 +130,7 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
     // y was placed with the normals of the last iterate; with the normals
     // just updated, y - y_next = r_y. Newton on (y, lambda) with r_y
     // eliminated: (A + C) dlambda = phi + G^T r_y, and the next y is
-    // y_next + (dt/gamma) G(y) dlambda. Without the G^T r_y term the normals
+    // y_next + diag(mob) G(y) dlambda. Without the G^T r_y term the normals
     // converge only linearly (30 % more iterations).
     for (auto c : act_) {
       const ContactPair& pc = pairs[c];
@@ -135,15 +145,15 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
       res.converged = true;
       return res;
     }
-    res.linear_iterations += solve_cg(pairs, opt.linear_rtol, dt_over_gamma);
+    res.linear_iterations += solve_cg(pairs, opt.linear_rtol, mob);
     y.swap(y_next_);
     for (std::size_t a = 0; a < act_.size(); ++a) {
       const std::uint32_t c = act_[a];
       const double updated = std::max(0.0, lambda_[c] + d_[a]);
-      const Vec3 f = (dt_over_gamma * (updated - lambda_[c])) * n_[c];
+      const Vec3 f = (updated - lambda_[c]) * n_[c];
       lambda_[c] = updated;
-      y[pairs[c].i] += f;
-      if (!pairs[c].wall) y[pairs[c].k] -= f;
+      y[pairs[c].i] += mob[pairs[c].i] * f;
+      if (!pairs[c].wall) y[pairs[c].k] -= mob[pairs[c].k] * f;
     }
   }
   res.iterations = opt.max_iterations;

@@ -46,14 +46,7 @@ void DemModel::save(ArchiveWriter& out) const {
   out.put(sums_);
   out.put(time_);
   out.put(steps_);
-  out.put(dt_);  // implicit scheme: the step just taken, the next try and the work so far
-  out.put(dt_try_);
-  out.put(counters_);
-  out.put(x_prev_);  // order 2: the last accepted steps
-  out.put(x_prev2_);
-  out.put(w_prev_);
-  out.put(dt_prev2_);
-  out.put(history_);
+  if (implicit_) implicit_->save(out);  // the step just taken, the next try, the work so far, the history
 }
 
 void DemModel::load(ArchiveReader& in) {
@@ -61,15 +54,7 @@ void DemModel::load(ArchiveReader& in) {
   in.get(sums_);
   in.get(time_);
   in.get(steps_);
-  in.get(dt_);
-  in.get(dt_try_);
-  in.get(counters_);
-  in.get(x_prev_);
-  in.get(x_prev2_);
-  in.get(w_prev_);
-  in.get(dt_prev2_);
-  in.get(history_);
-  near_x_.clear();  // the near list is derived: rebuilt at the next implicit step
+  if (implicit_) implicit_->load(in);
 }
 
 }  // namespace mrf

@@ -1,19 +1,21 @@
 // The backward Euler contact step of implicit_contact.hpp solved for the
 // contact forces instead of the positions (the compliance or "dual" form).
 //
-// The step is y = b + (dt/gamma) sum_c G_c lambda_c, where lambda_c >= 0 is the
-// Hertz force of candidate pair c and G_c puts +n_c on i and -n_c on k (n_c the
+// The step is y = b + M sum_c G_c lambda_c, M = diag(mob_i) the displacement
+// per unit force over the step of each particle (dt/gamma for IMEX Euler in
+// an imposed flow; more where the fluid at the particle yields, see
+// implicit_stepper.hpp), where lambda_c >= 0 is the Hertz force of candidate pair c and G_c puts +n_c on i and -n_c on k (n_c the
 // unit vector from k to i at y). The Hertz law, written as a compliance,
 //   phi_c(lambda) = h_c(y(lambda)) - (lambda_c / k)^{2/3} = 0   (lambda_c > 0),
 //   lambda_c = 0 and h_c(y(lambda)) <= 0                        (open),
 // closes the system. Newton on (y, lambda) with y eliminated and the normals
 // frozen over one linear solve: (A + C) dlambda = phi + G^T r_y on the active
 // contacts (r_y: what moving the normals to the current y leaves of the
-// position equation), A = (dt/gamma) G^T G (the
+// position equation), A = G^T M G (the
 // Delassus operator of the mobility, exact and linear) and C the diagonal
 // compliance derivative (2/3) k^{-2/3} lambda^{-1/3}. In the position form the
 // stiff Hertz law is the Jacobian, whose stiffness changes on the scale of the
-// overlap itself; here the linear part dominates (A / C ~ (dt/gamma) k_eff,
+// overlap itself; here the linear part dominates (A / C ~ mob k_eff,
 // the stiffness ratio of the step) and the Hertz nonlinearity is a small
 // correction, so Newton needs few iterations from the forces of the last step.
 // Open contacts are handled by projection (lambda >= 0) with an active set.
@@ -28,25 +30,28 @@
 
 namespace mrf {
 
-
 class ContactDual {
  public:
   // Solves the step for y (out), starting from the forces of the pairs at
   // positions x_start with the walls at walls_start (the last step's contact
-  // forces); `walls` at the end of the step. dt_over_gamma in s/kg. opt.tol
+  // forces); `walls` at the end of the step. mob: per particle (m/N). opt.tol
   // (m) bounds every overlap residual at convergence; opt.solver is unused.
   NewtonResult solve(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& b,
                      const std::vector<Vec3>& x_start, const WallParticles& walls_start, const WallParticles& walls,
-                     const Box& box, double radius,
-                     double hertz_k, double dt_over_gamma, const NewtonOptions& opt, std::vector<Vec3>& y);
+                     const Box& box, double radius, double hertz_k, const std::vector<double>& mob,
+                     const NewtonOptions& opt, std::vector<Vec3>& y);
+  // Adds the contact forces of the last solve (+n lambda on i, -n lambda on
+  // k) to f: pairwise opposite, so their sum over the free particles is the
+  // walls' push alone, whatever the Newton tolerance.
+  void add_forces(const std::vector<ContactPair>& pairs, std::vector<Vec3>& f) const;
 
  private:
-  void positions(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& b, double dt_over_gamma,
-                 std::vector<Vec3>& y) const;  // y = b + (dt/gamma) G lambda
+  void positions(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& b, const std::vector<double>& mob,
+                 std::vector<Vec3>& y) const;  // y = b + M G lambda
   // (A + C) p on the active set
   void apply(const std::vector<ContactPair>& pairs, const std::vector<double>& p, std::vector<double>& out,
-             double dt_over_gamma);
-  long solve_cg(const std::vector<ContactPair>& pairs, double rtol, double dt_over_gamma);
+             const std::vector<double>& mob);
+  long solve_cg(const std::vector<ContactPair>& pairs, double rtol, const std::vector<double>& mob);
 
   // Per candidate pair: force (N), compliance slope (m/N), Newton
   // right-hand side (m), unit normal (k to i; frozen over a linear solve).

@@ -1,0 +1,152 @@
+// The inertialess implicit-contact scheme as an object that owns its history
+// (REFERENCE.md §2-3), shared by every model whose particles are inertialess:
+// the imposed Couette flow of model 1 and the SPH carrier of models 2 and 3.
+//
+// Per free particle i the drift over a step of length dt is
+//   dx_i/dt = w0_i + (t - t_n) w1_i + mob_i(dt) F_c,i(x),
+//   mob_i(dt) = 1/gamma_i + dt/M_i,
+// w0 the explicit part at t_n (flow velocity at the particle plus the
+// non-contact forces over gamma), w1 its rate of change within the step
+// (zero in an imposed flow; for a coupled model the acceleration of the fluid
+// parcel at the particle), gamma_i the drag coefficient and M_i the inertia
+// of the fluid at the particle (1/M_i = 0 in an imposed flow). The Hertz
+// contacts F_c are implicit. Why the parcel term: an inertialess particle
+// passes its whole non-drag force to the fluid through the drag, so the fluid
+// parcel at it accelerates by F/M within the step; taking that into the
+// implicit solve makes the interphase drag relaxation (rate gamma/M, ~1e7 1/s
+// at phi = 0.3) unconditionally stable, as the parcel step of the inertial
+// coupled scheme does (integrate/coupled_steps.hpp).
+//
+// IMEX Euler (order 1) or variable-step IMEX BDF2 (order 2):
+//   y = b + c dt mob(dt) F_c(y),
+//   order 1: b = x_n + dt (w0_n + dt w1_n), c = 1
+//   order 2: omega = dt/dt_{n-1}, c = (1+omega)/(1+2 omega),
+//            b = a1 x_n - a2 x_{n-1} + c dt ((1+omega) w0_n - omega w0_{n-1} + dt w1_n),
+//            a1 = (1+omega)^2/(1+2 omega), a2 = omega^2/(1+2 omega),
+// solved for the contact forces (integrate/contact_dual.hpp, the default)
+// or the positions (implicit_contact.hpp; uniform mobility only). The local
+// error is estimated against a predictor (order 1: x_n + dt v_n; order 2:
+// Milne's device on the quadratic through the last three positions,
+// (2/11)|y - y_pred|) and sets the next step; a step is retried shorter when
+// Newton fails (dt/4), a particle or the walls move more than half the
+// contact margin (dt/2), or the error exceeds the tolerance.
+#pragma once
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "mrf/box.hpp"
+#include "mrf/integrate/contact_dual.hpp"
+#include "mrf/integrate/implicit_contact.hpp"
+#include "mrf/io/archive.hpp"
+#include "mrf/neighbors/verlet_list.hpp"
+#include "mrf/state.hpp"
+
+namespace mrf {
+
+enum class ContactFormulation { dual, primal };
+const char* to_string(ContactFormulation f);
+
+struct ImplicitOptions {
+  int order = 2;                         // 1: IMEX Euler; 2: IMEX BDF2
+  double tol_over_radius = 1e-2;         // largest local error per step / R
+  double newton_tol_over_radius = 1e-6;  // Newton converged: largest correction (primal) or overlap residual (dual) / R
+  double linear_rtol = 1e-1;             // relative residual of each linear solve (inexact Newton)
+  int max_newton = 20;                   // iterations before the step is retried at dt/4
+  bool fixed_step = false;               // every step = the dt given (convergence tests); no error control
+  ContactFormulation formulation = ContactFormulation::dual;
+  ContactLinearSolver solver = ContactLinearSolver::pcg;  // primal only
+};
+
+// Work of the implicit scheme since construction.
+struct ImplicitCounters {
+  long rejected = 0;           // steps rejected by the error test or the displacement bound
+  long newton_failures = 0;    // steps rejected because Newton did not converge
+  long newton_iterations = 0;  // over all attempts
+  long linear_iterations = 0;  // CG iterations (1 per Newton iteration for the direct solver)
+  double dt_min = std::numeric_limits<double>::infinity(), dt_max = 0;  // accepted steps (s)
+};
+
+// The explicit part of one step (see the header comment). w1 and inv_mass
+// may be empty (imposed flow: zero).
+struct ImplicitDrift {
+  std::vector<Vec3> w0;           // m/s
+  std::vector<Vec3> w1;           // m/s^2
+  std::vector<double> inv_gamma;  // 1/gamma_i (s/kg)
+  std::vector<double> inv_mass;   // 1/M_i (1/kg)
+};
+
+// Contact geometry and law of the step: identical spheres of `radius` (m),
+// Hertz prefactor (N/m^1.5), the walls' shear rate (1/s) and their speed (m/s).
+struct ImplicitContactParams {
+  double radius = 0, hertz_k = 0, shear_rate = 0, wall_speed = 0;
+};
+
+class ImplicitStepper {
+ public:
+  // dt_max (s): the largest step (stability bounds of the explicit parts);
+  // near_reach (m): reach of the near list of contact candidates, at most
+  // the range of the free-free Verlet list it is taken from.
+  ImplicitStepper(const ImplicitOptions& opt, const ImplicitContactParams& p, double dt_max, double near_reach);
+
+  // Candidates of the coming step at the current positions (from the Verlet
+  // lists valid there), and their Hertz forces per particle (N), which the
+  // caller subtracts from its pair forces to form the explicit part.
+  const std::vector<Vec3>& begin_step(const DemPairLists& lists, const FreeParticles& f, const WallParticles& walls,
+                                      const Box& box);
+  // One accepted step from the state of begin_step: f.x and f.v (the mean
+  // velocity over the step) updated, walls moved; returns its length (s).
+  // `time` (s) and `step` name the step in errors; dt_cap (s) lowers dt_max
+  // for this step (a bound that changes during a run).
+  double advance(const ImplicitDrift& d, FreeParticles& f, WallParticles& walls, const Box& box, double time,
+                 long step, double dt_cap = std::numeric_limits<double>::infinity());
+  // Contact forces of the accepted step on each free particle (N), as solved
+  // (dual) or at the new positions (primal); pairwise opposite.
+  void contact_forces_end(const FreeParticles& f, const WallParticles& walls, const Box& box,
+                          std::vector<Vec3>& out) const;
+
+  // The step that would pass t (s) is shortened to end on it.
+  void set_stop_time(double t) { stop_time_ = t; }
+  void set_options(const ImplicitOptions& o) { opt_ = o; }
+  const ImplicitOptions& options() const { return opt_; }
+  const ImplicitCounters& counters() const { return counters_; }
+  double dt() const { return dt_; }          // the last accepted step (s)
+  double max_dt() const { return dt_max_; }  // s
+
+  // The history (last steps, next try, counters); the near list is derived.
+  void save(ArchiveWriter& out) const;
+  void load(ArchiveReader& in);
+
+ private:
+  struct Attempt {
+    NewtonResult newton;
+    double error = 0, displacement = 0;  // m
+    std::uint32_t moved = 0;             // particle with the largest displacement
+  };
+  Attempt attempt(double dt, const ImplicitDrift& d, const NewtonOptions& nopt, FreeParticles& f,
+                  WallParticles& walls, const Box& box);
+
+  ImplicitOptions opt_;
+  ImplicitContactParams p_;
+  ImplicitCounters counters_;
+  double dt_, dt_max_, dt_try_, stop_time_ = std::numeric_limits<double>::infinity();
+  ContactNewton newton_;
+  ContactDual dual_;
+  std::vector<ContactPair> candidates_;
+  // Free-free pairs within near_reach_ = 2R + margin + near skin at the
+  // positions near_x_, taken from the (longer) dipole Verlet list; refreshed
+  // when a particle has moved half the near skin.
+  std::vector<ContactPair> near_ff_;
+  std::vector<Vec3> near_x_;
+  double near_reach_;
+  std::vector<Vec3> x0_, b_, fc_;
+  std::vector<double> mob_;
+  WallParticles walls0_;
+  // order 2: positions and explicit drift w0 of the last accepted steps,
+  // the step before dt_ (s), and how many accepted steps they hold (<= 2)
+  std::vector<Vec3> x_prev_, x_prev2_, w_prev_;
+  double dt_prev2_ = 0;
+  int history_ = 0;
+};
+
+}  // namespace mrf

@@ -1,0 +1,201 @@
+#include "mrf/integrate/implicit_stepper.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "mrf/error.hpp"
+#include "mrf/integrate/stability.hpp"
+#include "mrf/integrate/steps.hpp"
+
+namespace mrf {
+
+const char* to_string(ContactFormulation f) { return f == ContactFormulation::dual ? "dual" : "primal"; }
+
+namespace {
+// Milne's device for BDF2 against a quadratic extrapolation (equal steps):
+// BDF2's local error is -(2/9) h^3 x''', the extrapolation's +h^3 x''', so
+// the error is (2/9)/(1 + 2/9) = 2/11 of their difference.
+constexpr double k_bdf2_error_constant = 2.0 / 11.0;
+// A step shorter than this fraction of the largest allowed one is a failure.
+constexpr double k_dt_floor = 1e-7;
+
+// x moved to the periodic image nearest `ref` (positions are wrapped each step).
+Vec3 image_near(const Vec3& ref, const Vec3& x, const Box& box) { return ref - box.min_image(ref - x); }
+}  // namespace
+
+ImplicitStepper::ImplicitStepper(const ImplicitOptions& opt, const ImplicitContactParams& p, double dt_max,
+                                 double near_reach)
+    : opt_(opt), p_(p), dt_(dt_max), dt_max_(dt_max), dt_try_(0.1 * dt_max), near_reach_(near_reach) {}
+
+const std::vector<Vec3>& ImplicitStepper::begin_step(const DemPairLists& lists, const FreeParticles& f,
+                                                     const WallParticles& walls, const Box& box) {
+  const double r = p_.radius, margin = k_contact_margin_over_radius * r;
+  const double near_skin = near_reach_ - (2.0 * r + margin);
+  if (near_x_.size() != f.size() || 2.0 * max_displacement(f.x, near_x_, box) > near_skin) {
+    near_pairs(lists.ff, f.x, box, near_reach_, near_ff_);
+    near_x_ = f.x;
+  }
+  contact_candidates(near_ff_, lists.fw, f.x, walls, box, r, margin, candidates_);
+  contact_forces(candidates_, f.x, walls, box, r, p_.hertz_k, fc_);
+  x0_ = f.x;
+  walls0_.x = walls.x;
+  return fc_;
+}
+
+// One try of length dt from x0_; leaves y in f.x and the walls at t_{n+1}.
+ImplicitStepper::Attempt ImplicitStepper::attempt(double dt, const ImplicitDrift& d, const NewtonOptions& nopt,
+                                                  FreeParticles& f, WallParticles& walls, const Box& box) {
+  const std::size_t n = f.size();
+  const bool bdf2 = opt_.order == 2 && history_ >= 1;
+  const double om = dt / dt_;
+  const double c = bdf2 ? (1 + om) / (1 + 2 * om) : 1.0;
+  const bool parcel = !d.inv_mass.empty(), accelerating = !d.w1.empty();
+  b_.resize(n);
+  mob_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    mob_[i] = c * dt * (d.inv_gamma[i] + (parcel ? dt * d.inv_mass[i] : 0.0));
+    const Vec3 w = bdf2 ? Vec3((1 + om) * d.w0[i] - om * w_prev_[i]) : d.w0[i];
+    const Vec3 drift = accelerating ? Vec3(w + dt * d.w1[i]) : w;
+    if (bdf2) {
+      const double a1 = (1 + om) * (1 + om) / (1 + 2 * om), a2 = om * om / (1 + 2 * om);
+      b_[i] = a1 * x0_[i] - a2 * image_near(x0_[i], x_prev_[i], box) + c * dt * drift;
+    } else {
+      b_[i] = x0_[i] + dt * drift;
+    }
+  }
+  walls.x = walls0_.x;
+  move_walls(walls, p_.shear_rate, dt);
+  Attempt a;
+  if (opt_.formulation == ContactFormulation::dual) {
+    // Starts from the contact forces at x_n (walls at t_n).
+    a.newton = dual_.solve(candidates_, b_, x0_, walls0_, walls, box, p_.radius, p_.hertz_k, mob_, nopt, f.x);
+  } else {
+    if (parcel || std::any_of(d.inv_gamma.begin(), d.inv_gamma.end(),
+                              [&](double g) { return g != d.inv_gamma.front(); }))
+      throw InputError("numerics.implicit_formulation", "primal", "",
+                       "the primal contact solver needs one mobility for all particles (model dem_stokes)");
+    const double dt_over_gamma = n > 0 ? mob_.front() : 0.0;
+    for (std::size_t i = 0; i < n; ++i) f.x[i] = x0_[i] + dt * f.v[i];  // predictor
+    // Newton starts from the predictor or from x_n, whichever is lower in the
+    // merit function: after a sudden change (a contact made or broken) the
+    // extrapolated slope can throw the predictor far off.
+    const double phi_pred = newton_.merit(candidates_, b_, walls, box, p_.radius, p_.hertz_k, dt_over_gamma, f.x);
+    if (newton_.merit(candidates_, b_, walls, box, p_.radius, p_.hertz_k, dt_over_gamma, x0_) < phi_pred) f.x = x0_;
+    a.newton = newton_.solve(candidates_, b_, walls, box, p_.radius, p_.hertz_k, dt_over_gamma, nopt, f.x);
+  }
+  counters_.newton_iterations += a.newton.iterations;
+  counters_.linear_iterations += a.newton.linear_iterations;
+  // Error: order 1, half the distance from the linear predictor x_n + dt v_n
+  // ((dt/2)|v_{n+1} - v_n|); order 2, Milne's device on the quadratic through
+  // x_{n-2}, x_{n-1}, x_n (Lagrange weights l0, l1, l2 at t_{n+1}).
+  const bool quadratic = opt_.order == 2 && history_ >= 2;
+  double l0 = 0, l1 = 0, l2 = 0;
+  if (quadratic) {
+    const double t0 = -(dt_ + dt_prev2_), t1 = -dt_;
+    l0 = (dt - t1) * dt / ((t0 - t1) * t0);
+    l1 = (dt - t0) * dt / ((t1 - t0) * t1);
+    l2 = (dt - t0) * (dt - t1) / (t0 * t1);
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (quadratic) {
+      const Vec3 pred =
+          l0 * image_near(x0_[i], x_prev2_[i], box) + l1 * image_near(x0_[i], x_prev_[i], box) + l2 * x0_[i];
+      a.error = std::max(a.error, k_bdf2_error_constant * (f.x[i] - pred).norm());
+    } else {
+      a.error = std::max(a.error, 0.5 * (f.x[i] - x0_[i] - dt * f.v[i]).norm());
+    }
+    const double disp = (f.x[i] - x0_[i]).norm();
+    if (disp > a.displacement) a.displacement = disp, a.moved = static_cast<std::uint32_t>(i);
+  }
+  return a;
+}
+
+double ImplicitStepper::advance(const ImplicitDrift& d, FreeParticles& f, WallParticles& walls, const Box& box,
+                                double time, long step, double dt_cap) {
+  const double r = p_.radius, margin = k_contact_margin_over_radius * r;
+  const NewtonOptions nopt{opt_.newton_tol_over_radius * r, opt_.max_newton, opt_.linear_rtol, opt_.solver};
+  const double dt_max = std::min(dt_max_, dt_cap);
+  // Land on the stop time without leaving a sliver for the next step.
+  const double remaining = stop_time_ - time;
+  double dt = opt_.fixed_step ? dt_max : std::min(dt_try_, dt_max);
+  if (!opt_.fixed_step && remaining > 0 && remaining < 1.5 * dt) dt = remaining <= dt_max ? remaining : 0.5 * remaining;
+  const double dt_floor = k_dt_floor * std::min(dt, dt_max);
+  // The local error scales as dt^2 (order 1) or dt^3 (order 2).
+  const double exponent = opt_.order == 2 && history_ >= 2 ? -1.0 / 3.0 : -0.5;
+  for (;;) {
+    const Attempt a = attempt(dt, d, nopt, f, walls, box);
+    const bool too_far = a.displacement > 0.5 * margin || p_.wall_speed * dt > 0.5 * margin;
+    const double ratio = a.error / (opt_.tol_over_radius * r);
+    if (opt_.fixed_step && (!a.newton.converged || too_far)) {
+      std::ostringstream m;
+      m << "implicit fixed step " << dt << " s failed at step " << step << " (t = " << time << " s): "
+        << (a.newton.converged ? "particle " + std::to_string(a.moved) + " moved " + std::to_string(a.displacement / r) +
+                                     " R, more than half the contact margin"
+                               : "Newton did not converge; largest correction at particle " +
+                                     std::to_string(a.newton.worst));
+      throw NumericalError(m.str());
+    }
+    if (a.newton.converged && !too_far && (ratio <= 1.0 || opt_.fixed_step)) {
+      for (std::size_t i = 0; i < f.size(); ++i) f.v[i] = (f.x[i] - x0_[i]) / dt;
+      dt_try_ = std::min(dt_max_, dt * std::min(2.0, 0.9 * std::pow(std::max(ratio, 1e-6), exponent)));
+      if (opt_.order == 2) {
+        x_prev2_.swap(x_prev_);
+        x_prev_ = x0_;
+        w_prev_ = d.w0;
+        dt_prev2_ = dt_;
+        history_ = std::min(history_ + 1, 2);
+      }
+      break;
+    }
+    ++(a.newton.converged ? counters_.rejected : counters_.newton_failures);
+    dt *= !a.newton.converged ? 0.25 : too_far ? 0.5 : std::max(0.2, 0.9 * std::pow(ratio, exponent));
+    if (!(dt >= dt_floor)) {
+      std::ostringstream m;
+      m << "implicit step failed at step " << step << " (t = " << time << " s): the step size fell to " << dt
+        << " s (below " << k_dt_floor << " of the largest step " << dt_max << " s) without meeting the error"
+        << " tolerance or a converged Newton solve; last Newton correction largest at particle " << a.newton.worst;
+      throw NumericalError(m.str());
+    }
+  }
+  dt_ = dt;
+  counters_.dt_min = std::min(counters_.dt_min, dt);
+  counters_.dt_max = std::max(counters_.dt_max, dt);
+  return dt;
+}
+
+void ImplicitStepper::contact_forces_end(const FreeParticles& f, const WallParticles& walls, const Box& box,
+                                         std::vector<Vec3>& out) const {
+  if (opt_.formulation == ContactFormulation::dual) {
+    out.assign(f.size(), Vec3::Zero());
+    dual_.add_forces(candidates_, out);
+  } else {
+    contact_forces(candidates_, f.x, walls, box, p_.radius, p_.hertz_k, out);
+  }
+}
+
+void ImplicitStepper::save(ArchiveWriter& out) const {
+  out.put(dt_);
+  out.put(dt_try_);
+  out.put(counters_);
+  out.put(x_prev_);
+  out.put(x_prev2_);
+  out.put(w_prev_);
+  out.put(dt_prev2_);
+  out.put(history_);
+}
+
+void ImplicitStepper::load(ArchiveReader& in) {
+  in.get(dt_);
+  in.get(dt_try_);
+  in.get(counters_);
+  in.get(x_prev_);
+  in.get(x_prev2_);
+  in.get(w_prev_);
+  in.get(dt_prev2_);
+  in.get(history_);
+  near_x_.clear();  // the near list is derived: rebuilt at the next step
+}
+
+}  // namespace mrf
