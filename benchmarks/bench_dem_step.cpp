@@ -6,19 +6,22 @@
 // Counters: particle-steps/s and pair evaluations/s (pairs in the Verlet list).
 #include <benchmark/benchmark.h>
 
+#include <memory>
+
 #include "mrf/io/toml_scene.hpp"
+#include "mrf/scene/build_model.hpp"
 #include "mrf/scene/dem_model.hpp"
-#include "mrf/scene/run.hpp"
 
 namespace {
 
+// The model `mrf run` builds for the paper scene with this integrator (Couette
+// start, the scene's implicit options), past its random start.
 mrf::DemModel paper_model(mrf::IntegratorId scheme) {
   const auto scene = mrf::load_scene(MRF_SOURCE_DIR "/experiments/scenes/paper_dem_stokes.toml",
                                      {std::string("numerics.integrator=") + mrf::to_string(scheme)});
-  const mrf::DemParams p = mrf::dem_params(scene.config);
-  const auto ts = mrf::choose_time_step(scene, p);
-  mrf::DemModel model(mrf::build_shear_cell(scene.config), p, ts.scheme, ts.dt);
-  for (int i = 0; i < 200; ++i) model.step();  // leave the random start
+  mrf::BuiltModel b = mrf::build_model(scene);
+  mrf::DemModel model = std::move(dynamic_cast<mrf::DemModel&>(*b.model));
+  for (int i = 0; i < 200; ++i) model.step();
   return model;
 }
 

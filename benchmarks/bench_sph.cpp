@@ -23,7 +23,7 @@ mrf::FluidCell paper_cell() {
 
 void run(benchmark::State& state, bool implicit) {
   mrf::FluidCell c = paper_cell();
-  const double dt = 0.5 * mrf::binding_limit(mrf::stability_limits(c, implicit)).dt;
+  const double dt = 0.5 * mrf::smallest(mrf::stability_limits(c, implicit));
   for (auto _ : state) {
     if (implicit)
       benchmark::DoNotOptimize(mrf::step_implicit(c, dt));

@@ -10,6 +10,7 @@
 #include "criterion_command.hpp"
 #include "mrf/error.hpp"
 #include "mrf/io/lammps_data.hpp"
+#include "mrf/scene/build_model.hpp"
 #include "mrf/scene/run.hpp"
 #include "mrf/study/sweep.hpp"
 

@@ -19,7 +19,8 @@
 #include "mrf/io/toml_scene.hpp"
 #include "mrf/scene/coupled_model.hpp"
 #include "mrf/scene/dem_params.hpp"
-#include "mrf/scene/run_coupled.hpp"
+#include "mrf/integrate/stability.hpp"
+#include "mrf/scene/build_model.hpp"
 
 namespace mrf {
 namespace {
@@ -149,36 +150,65 @@ TEST(CoupledModel, BuoyancyIsModelAVolumeTimesPressureGradient) {
 
 // The fluid step comes from the SPH limits alone: the same for Stokes and
 // Di Felice drag (whose friction is ~2.5x larger at eps = 0.7, so its
-// relaxation time is shorter), and several times tau_p at Mn = 1e-2.
+// relaxation time is shorter), and several times tau_p at Mn = 1e-2. The
+// inertial scheme splits it into contact-bound DEM sub-steps; the
+// inertialess one (auto at this St) takes error-controlled steps up to the
+// implicit scheme's bounds, with no contact or drag limit.
 TEST(CoupledModel, TimeStepIsNotBoundByTheDragRelaxationTime) {
   for (const char* model : {"demsph_stokes", "demsph_dd"}) {
-    const LoadedScene scene = load_scene(kSmall, {std::string("scene.model=\"") + model + "\""});
-    const DemParams p = dem_params(scene.config);
-    const ShearCell cell = build_shear_cell(scene.config);
-    const FluidCell f = build_coupled_fluid(scene.config, cell);
-    const CoupledTimeStep t = choose_coupled_time_step(scene, p, f, 0.5);
-    for (const auto& l : t.fluid_limits) EXPECT_EQ(l.name.find("drag"), std::string::npos) << l.name;
-    EXPECT_NEAR(t.dt_fluid, 0.5 * coupled_viscous_limit(f, 0.5), 1e-20);
-    EXPECT_GT(t.dt_fluid / p.tau_p, 0.25);
-    EXPECT_GT(t.substeps, 5);
+    for (const char* integrator : {"verlet_exp", "auto"}) {
+      const LoadedScene scene = load_scene(kSmall, {std::string("scene.model=\"") + model + "\"",
+                                                    std::string("numerics.integrator=\"") + integrator + "\""});
+      const DemParams p = dem_params(scene.config);
+      const ShearCell cell = build_shear_cell(scene.config);
+      const FluidCell f = build_coupled_fluid(scene.config, cell);
+      const CoupledTimeStep t = choose_coupled_time_step(scene, p, f, 0.5);
+      for (const auto& l : t.fluid_limits) EXPECT_EQ(l.name.find("drag"), std::string::npos) << l.name;
+      EXPECT_NEAR(t.stepping.dt_fluid, 0.5 * coupled_viscous_limit(f, 0.5), 1e-20);
+      EXPECT_GT(t.stepping.dt_fluid / p.tau_p, 0.25);
+      if (std::string(integrator) == "verlet_exp") {
+        EXPECT_EQ(t.stepping.scheme, CoupledScheme::inertial);
+        EXPECT_GT(t.stepping.substeps, 5);
+      } else {
+        EXPECT_LE(stokes_number(p), k_inertialess_max_stokes);
+        EXPECT_EQ(t.stepping.scheme, CoupledScheme::inertialess);
+        EXPECT_EQ(t.stepping.dt_max, smallest(dem_limits(p, scene.config.gap, IntegratorId::implicit)));
+        EXPECT_GT(t.stepping.dt_max, 5 * t.stepping.dt_fluid);
+        for (const auto& l : t.dem_limits) {
+          if (l.name == "hertz contact" || l.name == "drag relaxation") {
+            EXPECT_TRUE(std::isinf(l.dt)) << l.name;
+          }
+        }
+      }
+    }
   }
 }
 
 // Extreme Mason numbers of the sweep on the small scene, both coupled
-// models: runs end without a NumericalError and with finite stress (Mn = 1
-// to strain 4: before the SPH walls reflected particles reaching the plane,
-// an SPH particle went through the lower wall at strain 2.7).
+// models and both schemes: runs end without a NumericalError, with finite
+// stress and momentum conserved (Mn = 1 to strain 4: before the SPH walls
+// reflected particles reaching the plane, an SPH particle went through the
+// lower wall at strain 2.7). The inertialess runs write rows by strain, at
+// the largest step: 32 rows need strain 0.3 at Mn = 1e-3.
 TEST(CoupledModel, SmallSceneRunsAtExtremeMasonNumbers) {
+  struct Case {
+    const char *mn, *strain, *integrator;
+  };
   for (const char* model : {"demsph_stokes", "demsph_dd"})
-    for (const auto& [mn, strain] : {std::pair{"1e-3", "0.01"}, std::pair{"1.0", "4.0"}}) {
+    for (const auto& [mn, strain, integrator] :
+         {Case{"1e-3", "0.01", "verlet_exp"}, Case{"1.0", "4.0", "verlet_exp"}, Case{"1e-3", "0.3", "implicit"},
+          Case{"1.0", "1.0", "implicit"}}) {
       const LoadedScene scene =
           load_scene(kSmall, {std::string("scene.model=\"") + model + "\"", std::string("drive.mason=") + mn,
-                              std::string("drive.strain=") + strain, "drive.warmup_strain=0.0", "output.every=1"});
+                              std::string("drive.strain=") + strain, "drive.warmup_strain=0.0", "output.every=1",
+                              std::string("numerics.integrator=\"") + integrator + "\""});
       RunSummary s;
-      ASSERT_NO_THROW(s = run_scene(scene, {"", true})) << model << " Mn " << mn;
-      EXPECT_TRUE(std::isfinite(s.stress_total.mean)) << model << " Mn " << mn;
-      EXPECT_LT(s.extra.at("momentum_drift_relative"), 1e-12);  // wall reflections included
-      RecordProperty(std::string(model) + "_Mn" + mn + "_sph_wall_reflections",
+      ASSERT_NO_THROW(s = run_scene(scene, {"", true})) << model << " Mn " << mn << " " << integrator;
+      EXPECT_TRUE(std::isfinite(s.stress_total.mean)) << model << " Mn " << mn << " " << integrator;
+      // wall reflections included; implicit viscosity leaves its CG residual
+      EXPECT_LT(s.extra.at("momentum_drift_relative"), s.integrator.find("implicit_viscosity") != std::string::npos ? 1e-8 : 1e-12)
+          << model << " Mn " << mn << " " << integrator;
+      RecordProperty(std::string(model) + "_Mn" + mn + "_" + integrator + "_sph_wall_reflections",
                      std::to_string(s.extra.at("sph_wall_reflections")));
     }
 }
@@ -207,8 +237,8 @@ TEST(CoupledModel, BaseSceneRunsUnderAllThreeModels) {
   for (const char* model : {"dem_stokes", "demsph_stokes", "demsph_dd"}) {
     std::vector<std::string> sets{std::string("scene.model=\"") + model + "\"", "drive.strain=0.04",
                                   "drive.warmup_strain=0.0", "output.every=1"};
-    // at 200 GPa model 1 picks the implicit scheme, whose ~20 steps are too few rows here
-    if (std::string(model) == "dem_stokes") sets.push_back("numerics.integrator=\"verlet_exp\"");
+    // at 200 GPa auto picks the implicit scheme, whose ~20 steps are too few rows here
+    sets.push_back("numerics.integrator=\"verlet_exp\"");
     const LoadedScene scene = load_scene(MRF_SOURCE_DIR "/experiments/scenes/small_dem_stokes.toml", sets);
     const RunSummary s = run_scene(scene, {"", true});
     EXPECT_EQ(s.model, model);

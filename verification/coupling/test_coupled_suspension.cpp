@@ -16,6 +16,7 @@
 #include "mrf/io/toml_scene.hpp"
 #include "mrf/scene/coupled_model.hpp"
 #include "mrf/scene/dem_params.hpp"
+#include "mrf/scene/build_model.hpp"
 #include "mrf/scene/run.hpp"
 
 namespace mrf {
@@ -106,7 +107,7 @@ TEST(CoupledSuspension, NonMagneticParticlesLeaveTheCouetteStressUnchanged) {
   for (const char* model : {"demsph_stokes", "demsph_dd"}) {
     const LoadedScene scene =
         load_scene(kSmall, {std::string("scene.model=\"") + model + "\"", "particles.magnetization=0.0",
-                            "particles.volume_fraction=0.01", "drive.shear_rate=2.8e4", "drive.strain=0.3",
+                            "particles.volume_fraction=0.01", "drive.shear_rate=2.8e4", "drive.strain=0.6",
                             "drive.warmup_strain=0.1"});
     const RunSummary s = run_scene(scene, {"", true});
     const double tau = scene.config.viscosity * scene.config.shear_rate;

@@ -111,11 +111,11 @@ TEST(SphParams, LimitsAreNamedAndDtAboveThemRefused) {
   const FluidCell c = channel(15, 100.0, 20.0);
   const auto lim = stability_limits(c, false);
   ASSERT_EQ(lim.size(), 3u);
-  EXPECT_EQ(binding_limit(lim).name.rfind("viscous", 0), 0u);
-  EXPECT_NEAR(binding_limit(lim).dt, 0.125 * c.h * c.h / k_nu, 1e-20);
+  EXPECT_EQ(binding(lim).name.rfind("viscous", 0), 0u);
+  EXPECT_NEAR(binding(lim).dt, 0.125 * c.h * c.h / k_nu, 1e-20);
   EXPECT_EQ(stability_limits(c, true).size(), 2u);  // no viscous limit when implicit
   try {
-    check_time_step(c, 1.01 * binding_limit(lim).dt, false);
+    check_time_step(c, 1.01 * binding(lim).dt, false);
     FAIL() << "dt above the viscous limit accepted";
   } catch (const InputError& e) {
     EXPECT_EQ(e.key(), "numerics.dt");

@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "mrf/error.hpp"
-#include "mrf/fluid/couette_sph.hpp"
+#include "mrf/scene/fluid_only.hpp"
 
 namespace mrf {
 namespace {

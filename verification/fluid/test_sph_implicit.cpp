@@ -13,8 +13,6 @@ namespace {
 
 constexpr double k_gdot = 100.0;
 
-double viscous_limit(const FluidCell& c) { return 0.125 * c.h * c.h / c.params.kinematic_viscosity(); }
-
 double velocity_difference(const FluidCell& a, const FluidCell& b) {
   double d = 0, n = 0;
   for (std::size_t i = 0; i < a.fluid.size(); ++i) {
@@ -44,7 +42,7 @@ TEST(SphImplicit, StableAndBoundedFarBeyondViscousLimit) {
   for (double factor : {10.0, 30.0}) {
     FluidCell c = channel(15, 10.0, 0.0);
     const double dt = factor * viscous_limit(c);
-    ASSERT_LT(dt, binding_limit(stability_limits(c, true)).dt);
+    ASSERT_LT(dt, binding(stability_limits(c, true)).dt);
     ASSERT_NO_THROW(check_time_step(c, dt, true));
     EXPECT_THROW(check_time_step(c, dt, false), InputError);
     const auto t0 = std::chrono::steady_clock::now();
@@ -76,7 +74,7 @@ TEST(SphImplicit, LowReynoldsHighViscosityStable) {
     ASSERT_LE(reynolds_number(e.params, e.box), 1e-4);
     const double T = k_gap * k_gap * k_rho / eta;
     run_to(e, 0.6 * T, explicit_dt(e), false);
-    const double dt_i = std::min(100 * viscous_limit(i), binding_limit(stability_limits(i, true)).dt);
+    const double dt_i = std::min(100 * viscous_limit(i), binding(stability_limits(i, true)).dt);
     run_to(i, 0.6 * T, dt_i, true);
     for (const FluidCell* c : {&e, &i}) {
       EXPECT_LT(profile_error(*c, couette_exact(*c, c->time)), 2e-3) << "eta = " << eta;

@@ -55,7 +55,7 @@ double max_distance_over_radius(const DemModel& a, const DemModel& b) {
 
 TEST(ContactDual, FixedStepsEqualThePrimalSolve) {
   const Small s = small();
-  const double dt = 3.0 * smallest(dem_limits(s.p, s.config, IntegratorId::verlet_exp));
+  const double dt = 3.0 * smallest(dem_limits(s.p, s.config.gap, IntegratorId::verlet_exp));
   DemModel dual = implicit_model(s, dt, ContactFormulation::dual, true);
   DemModel primal = implicit_model(s, dt, ContactFormulation::primal, true);
   double moved = 0;
@@ -94,7 +94,7 @@ TEST(ContactDual, LargeFixedStepsEqualThePrimalSolve) {
 
 TEST(ContactDual, TwoStageCandidateSearchEqualsTheFullSearch) {
   const Small s = small();
-  DemModel m = implicit_model(s, smallest(dem_limits(s.p, s.config, IntegratorId::implicit)),
+  DemModel m = implicit_model(s, smallest(dem_limits(s.p, s.config.gap, IntegratorId::implicit)),
                               ContactFormulation::dual, false);
   for (int n = 0; n < 100; ++n) m.step();
   const auto& c = m.cell();

@@ -30,6 +30,7 @@
 #include "mrf/observe/block_average.hpp"
 #include "mrf/observe/stress.hpp"
 #include "mrf/scene/dem_model.hpp"
+#include "mrf/scene/build_model.hpp"
 #include "mrf/scene/run.hpp"
 
 namespace mrf {

@@ -14,6 +14,7 @@
 
 #include "mrf/forces/hertz.hpp"
 #include "mrf/io/toml_scene.hpp"
+#include "mrf/scene/build_model.hpp"
 #include "mrf/scene/run.hpp"
 
 namespace mrf {
@@ -39,9 +40,9 @@ TEST(ImplicitChoice, AutoPrefersImplicitAtTheRealModulusAndExplicitAtASoftOne) {
     const DemParams p = dem_params(s.config);
     const TimeStepChoice t = choose_time_step(s, p);
     EXPECT_EQ(t.scheme, want) << youngs;
-    const double explicit_dt = std::max(smallest(dem_limits(p, s.config, IntegratorId::verlet_exp)),
-                                        smallest(dem_limits(p, s.config, IntegratorId::overdamped)));
-    const auto im = dem_limits(p, s.config, IntegratorId::implicit);
+    const double explicit_dt = std::max(smallest(dem_limits(p, s.config.gap, IntegratorId::verlet_exp)),
+                                        smallest(dem_limits(p, s.config.gap, IntegratorId::overdamped)));
+    const auto im = dem_limits(p, s.config.gap, IntegratorId::implicit);
     std::printf("%s: explicit limit %.3e s, implicit bound %.3e s ('%s'), ratio %.1f\n", youngs, explicit_dt,
                 smallest(im), binding(im).name.c_str(), smallest(im) / explicit_dt);
     EXPECT_EQ(want == IntegratorId::implicit, smallest(im) > k_implicit_preference * explicit_dt);
@@ -54,7 +55,7 @@ TEST(ImplicitRun, ShortRunReportsCountsAndBoundedSteps) {
   const LoadedScene s = small({"drive.strain=0.6", "drive.warmup_strain=0.1", "numerics.integrator=implicit"});
   const RunSummary r = run_scene(s, RunOptions{"", true});
   const DemParams p = dem_params(s.config);
-  const double explicit_dt = smallest(dem_limits(p, s.config, IntegratorId::verlet_exp));
+  const double explicit_dt = smallest(dem_limits(p, s.config.gap, IntegratorId::verlet_exp));
   for (const char* key : {"implicit_rejected_steps", "implicit_newton_iterations", "implicit_linear_iterations",
                           "implicit_newton_failures", "implicit_dt_min", "implicit_dt_max", "implicit_dt_mean"})
     ASSERT_TRUE(r.extra.count(key)) << key;

@@ -30,6 +30,7 @@
 #include "mrf/io/quantity.hpp"
 #include "mrf/io/toml_scene.hpp"
 #include "mrf/scene/dem_model.hpp"
+#include "mrf/scene/build_model.hpp"
 #include "mrf/scene/run.hpp"
 
 namespace mrf {
@@ -532,25 +533,27 @@ TEST(RunIntegratorChoice, SmallSceneIsBoundByHertzContactWithVerletExp) {
   EXPECT_EQ(j["integrator"], "verlet_exp");
   EXPECT_EQ(j["dt_bound_by"], "hertz contact");
   const DemParams p = dem_params(r.scene.config);
-  const auto ve = dem_limits(p, r.scene.config, IntegratorId::verlet_exp);
-  const auto od = dem_limits(p, r.scene.config, IntegratorId::overdamped);
+  const auto ve = dem_limits(p, r.scene.config.gap, IntegratorId::verlet_exp);
+  const auto od = dem_limits(p, r.scene.config.gap, IntegratorId::overdamped);
   EXPECT_GT(smallest(ve), smallest(od));
   EXPECT_EQ(r.summary.dt, r.scene.config.dt_safety * smallest(ve));
 }
 
-// Auto picks the explicit scheme whose binding (smallest) limit is largest,
-// ties to verlet_exp, with dt = dt_safety times that limit; unless that limit
-// is more than k_implicit_preference times below the implicit step bound:
-// then implicit, with dt = the bound (its largest step).
+// Auto keeps the particles' inertia (verlet_exp) above the Stokes bound;
+// below it, it picks the explicit scheme whose binding (smallest) limit is
+// largest, ties to verlet_exp, with dt = dt_safety times that limit; unless
+// that limit is more than k_implicit_preference times below the implicit
+// step bound: then implicit, with dt = the bound (its largest step).
 void expect_auto_rule(const LoadedScene& s, const std::string& label) {
   const DemParams p = dem_params(s.config);
-  const auto ve = dem_limits(p, s.config, IntegratorId::verlet_exp);
-  const auto od = dem_limits(p, s.config, IntegratorId::overdamped);
-  const auto im = dem_limits(p, s.config, IntegratorId::implicit);
+  const auto ve = dem_limits(p, s.config.gap, IntegratorId::verlet_exp);
+  const auto od = dem_limits(p, s.config.gap, IntegratorId::overdamped);
+  const auto im = dem_limits(p, s.config.gap, IntegratorId::implicit);
   const double explicit_dt = std::max(smallest(ve), smallest(od));
-  const IntegratorId want = k_implicit_preference * explicit_dt < smallest(im) ? IntegratorId::implicit
-                            : smallest(ve) >= smallest(od)                     ? IntegratorId::verlet_exp
-                                                                               : IntegratorId::overdamped;
+  const IntegratorId want = stokes_number(p) > k_inertialess_max_stokes          ? IntegratorId::verlet_exp
+                            : k_implicit_preference * explicit_dt < smallest(im) ? IntegratorId::implicit
+                            : smallest(ve) >= smallest(od)                       ? IntegratorId::verlet_exp
+                                                                                 : IntegratorId::overdamped;
   const TimeStepChoice t = choose_time_step(s, p);
   EXPECT_EQ(t.scheme, want) << label << ": verlet_exp limit " << smallest(ve)
                             << " s, overdamped limit " << smallest(od) << " s, implicit bound " << smallest(im);
@@ -569,6 +572,21 @@ TEST(RunIntegratorChoice, AutoPicksTheSchemeWhoseBindingLimitIsLargest) {
     }
 }
 
+// Above the Stokes bound the particles keep their inertia even where the
+// implicit scheme's step bound is many times the explicit one (iron's
+// modulus), which would otherwise choose it.
+TEST(RunIntegratorChoice, AutoKeepsInertiaAboveTheStokesBound) {
+  for (const char* mason : {"0.003", "0.01"}) {
+    const LoadedScene s = scene({"particles.density=78000", std::string("drive.mason=") + mason,
+                                 "contact.youngs_modulus=\"200 GPa\"", "numerics.integrator=auto"});
+    const DemParams p = dem_params(s.config);
+    ASSERT_GT(stokes_number(p), k_inertialess_max_stokes) << mason;
+    EXPECT_GT(smallest(dem_limits(p, s.config.gap, IntegratorId::implicit)),
+              k_implicit_preference * smallest(dem_limits(p, s.config.gap, IntegratorId::verlet_exp)));
+    EXPECT_EQ(choose_time_step(s, p).scheme, IntegratorId::verlet_exp) << mason;
+  }
+}
+
 TEST(RunIntegratorChoice, TinyDensityRunReportsTheSchemeOfTheRule) {
   const std::vector<std::string> set = {"particles.density=7.8", "contact.youngs_modulus=\"0.45 GPa\"",
                                         "numerics.integrator=auto", "drive.mason=0.1",
@@ -576,8 +594,8 @@ TEST(RunIntegratorChoice, TinyDensityRunReportsTheSchemeOfTheRule) {
                                         "output.every=0"};
   const LoadedScene s = scene(set);
   const DemParams p = dem_params(s.config);
-  const auto ve = dem_limits(p, s.config, IntegratorId::verlet_exp);
-  const auto od = dem_limits(p, s.config, IntegratorId::overdamped);
+  const auto ve = dem_limits(p, s.config.gap, IntegratorId::verlet_exp);
+  const auto od = dem_limits(p, s.config.gap, IntegratorId::overdamped);
   const bool ve_wins = smallest(ve) >= smallest(od);
   const RunSummary r = run_scene(s, RunOptions{"", true});
   EXPECT_EQ(r.integrator, ve_wins ? "verlet_exp" : "overdamped");

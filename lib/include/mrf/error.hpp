@@ -12,8 +12,10 @@ class InputError : public std::runtime_error {
  public:
   InputError(const std::string& key, const std::string& value, const std::string& where,
              const std::string& why)
-      : std::runtime_error(format(key, value, where, why)), key_(key) {}
+      : std::runtime_error(format(key, value, where, why)), key_(key), value_(value), why_(why) {}
   const std::string& key() const { return key_; }
+  // The same error placed at `where` (a caller that knows the file line).
+  InputError at(const std::string& where) const { return InputError(key_, value_, where, why_); }
 
  private:
   static std::string format(const std::string& key, const std::string& value,
@@ -24,7 +26,7 @@ class InputError : public std::runtime_error {
     s += ": " + why;
     return s;
   }
-  std::string key_;
+  std::string key_, value_, why_;
 };
 
 // A run produced a non-finite number or left a stability bound.

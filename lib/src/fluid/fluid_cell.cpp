@@ -5,6 +5,7 @@
 #include "mrf/fluid/kernel.hpp"
 #include "mrf/fluid/viscosity.hpp"
 #include "mrf/neighbors/cell_list.hpp"
+#include "mrf/neighbors/verlet_list.hpp"
 
 namespace mrf {
 
@@ -87,12 +88,13 @@ FluidCell build_fluid_cell(const Box& box, const FluidParams& params) {
   return cell;
 }
 
-SphPairs find_pairs(const FluidCell& cell) {
+SphPairs find_pairs(const FluidCell& cell) { return find_pairs(cell, k_kernel_support * cell.h); }
+
+SphPairs find_pairs(const FluidCell& cell, double rc) {
   SphPairs out;
   out.fluid_fluid.reserve(cell.pairs.fluid_fluid.size());
   out.fluid_wall.reserve(cell.pairs.fluid_wall.size());
   const Box& box = cell.box;
-  const double rc = k_kernel_support * cell.h;
   const double reach = 0.5 * box.gap + cell.wall.depth.back() + cell.params.spacing;
   CellGrid grid(box, -reach, reach, rc);
   const MinImageYZ mi(box);
@@ -112,6 +114,42 @@ SphPairs find_pairs(const FluidCell& cell) {
                      [&](const Vec3& e, double r) { out.fluid_wall.push_back({a, b, e, r}); });
     });
   return out;
+}
+
+void update_pairs(FluidCell& cell, SphPairCache& cache) {
+  const double rc = k_kernel_support * cell.h;
+  if (!(cache.skin > 0)) {
+    cell.pairs = find_pairs(cell);
+    return;
+  }
+  const Box& box = cell.box;
+  const bool stale = cache.x_fluid.size() != cell.fluid.size() || cache.x_wall.size() != cell.wall.size();
+  const double df = stale ? 0.0 : max_displacement(cell.fluid.x, cache.x_fluid, box);
+  const double dw = stale ? 0.0 : max_displacement(cell.wall.x, cache.x_wall, box);
+  if (stale || 2.0 * df > cache.skin || df + dw > cache.skin) {
+    cache.candidates = find_pairs(cell, rc + cache.skin);
+    cache.x_fluid = cell.fluid.x;
+    cache.x_wall = cell.wall.x;
+    ++cache.builds;
+  }
+  const MinImageYZ mi(box);
+  auto moved = [&](const Vec3& x, const Vec3& ref) {
+    return Vec3(x.x() - ref.x(), mi.wrap_y(x.y() - ref.y()), mi.wrap_z(x.z() - ref.z()));
+  };
+  const double rc2 = rc * rc;
+  SphPairs& out = cell.pairs;
+  out.fluid_fluid.clear();
+  out.fluid_wall.clear();
+  for (const SphPair& c : cache.candidates.fluid_fluid) {
+    const Vec3 r = c.r_ab + moved(cell.fluid.x[c.a], cache.x_fluid[c.a]) - moved(cell.fluid.x[c.b], cache.x_fluid[c.b]);
+    const double r2 = r.squaredNorm();
+    if (r2 < rc2) out.fluid_fluid.push_back({c.a, c.b, r, std::sqrt(r2)});
+  }
+  for (const SphPair& c : cache.candidates.fluid_wall) {
+    const Vec3 r = c.r_ab + moved(cell.fluid.x[c.a], cache.x_fluid[c.a]) - moved(cell.wall.x[c.b], cache.x_wall[c.b]);
+    const double r2 = r.squaredNorm();
+    if (r2 < rc2) out.fluid_wall.push_back({c.a, c.b, r, std::sqrt(r2)});
+  }
 }
 
 }  // namespace mrf

@@ -92,6 +92,12 @@ void refresh(FluidCell& c) {
   update_pressures(c);
 }
 
+void refresh(FluidCell& c, SphPairCache& cache) {
+  update_pairs(c, cache);
+  summation_density(c);
+  update_pressures(c);
+}
+
 void update_pressures(FluidCell& c) {
   c.fluid.p.resize(c.fluid.size());
   const bool porous = !c.fluid.eps.empty(), labelled = !c.fluid.rest_density.empty();
@@ -143,21 +149,17 @@ ImplicitSolveStats step_implicit(FluidCell& c, double dt) {
   return stats;
 }
 
-std::vector<SphStepLimit> stability_limits(const FluidCell& c, bool implicit_viscosity) {
+double viscous_limit(const FluidCell& c) { return 0.125 * c.h * c.h / c.params.kinematic_viscosity(); }
+
+std::vector<StabilityLimit> stability_limits(const FluidCell& c, bool implicit_viscosity) {
   double vmax = std::abs(c.params.shear_rate) * 0.5 * c.box.gap;
   for (const Vec3& v : c.fluid.v) vmax = std::max(vmax, v.norm());
   double fmax = 0.0;
   for (const Vec3& f : external_acceleration(c)) fmax = std::max(fmax, f.norm());
-  std::vector<SphStepLimit> out{{"cfl 0.25 h/(c0 + |v|max)", 0.25 * c.h / (c.c0 + vmax)}};
-  if (!implicit_viscosity)
-    out.push_back({"viscous 0.125 h^2/nu", 0.125 * c.h * c.h / c.params.kinematic_viscosity()});
-  if (fmax > 0.0) out.push_back({"force 0.25 sqrt(h/|f|max)", 0.25 * std::sqrt(c.h / fmax)});
+  std::vector<StabilityLimit> out{{"cfl", 0.25 * c.h / (c.c0 + vmax), "0.25 h/(c0 + |v|max), Morris et al. 1997"}};
+  if (!implicit_viscosity) out.push_back({"viscous", viscous_limit(c), "0.125 h^2/nu, Morris et al. 1997"});
+  if (fmax > 0.0) out.push_back({"force", 0.25 * std::sqrt(c.h / fmax), "0.25 sqrt(h/|f|max), Morris et al. 1997"});
   return out;
-}
-
-const SphStepLimit& binding_limit(const std::vector<SphStepLimit>& limits) {
-  return *std::min_element(limits.begin(), limits.end(),
-                           [](const SphStepLimit& l, const SphStepLimit& r) { return l.dt < r.dt; });
 }
 
 void check_time_step(const FluidCell& c, double dt, bool implicit_viscosity) {
@@ -166,7 +168,7 @@ void check_time_step(const FluidCell& c, double dt, bool implicit_viscosity) {
     s << dt;
     throw InputError("numerics.dt", s.str(), "", "must be positive and finite");
   }
-  for (const SphStepLimit& l : stability_limits(c, implicit_viscosity))
+  for (const StabilityLimit& l : stability_limits(c, implicit_viscosity))
     if (dt > l.dt) {
       std::ostringstream s, v;
       v << dt;

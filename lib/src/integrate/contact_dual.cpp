@@ -17,15 +17,24 @@ Vec3 pair_vector(const ContactPair& c, const std::vector<Vec3>& x, const WallPar
 }
 }  // namespace
 
-void ContactDual::positions(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& b,
-                            const std::vector<double>& mob, std::vector<Vec3>& y) const {
-  y = b;
-  for (std::size_t c = 0; c < pairs.size(); ++c) {
-    if (lambda_[c] <= 0) continue;
-    const Vec3 f = lambda_[c] * n_[c];
-    y[pairs[c].i] += mob[pairs[c].i] * f;
-    if (!pairs[c].wall) y[pairs[c].k] -= mob[pairs[c].k] * f;
+void ContactDual::move(const std::vector<ContactPair>& pairs, const std::vector<double>& q, bool active_only,
+                       std::vector<Vec3>& y) {
+  const std::vector<double>& mob = *mob_;
+  const std::size_t m = active_only ? act_.size() : pairs.size();
+  if (coupled_) s_.assign(y.size(), Vec3::Zero());
+  for (std::size_t a = 0; a < m; ++a) {
+    const std::size_t c = active_only ? act_[a] : a;
+    if (q[a] == 0) continue;
+    const ContactPair& pc = pairs[c];
+    const Vec3 f = q[a] * n_[c];
+    y[pc.i] += mob[pc.i] * f;
+    if (!pc.wall) y[pc.k] -= mob[pc.k] * f;
+    if (coupled_) {
+      s_[pc.i] += f;
+      if (!pc.wall) s_[pc.k] -= f;
+    }
   }
+  if (coupled_) coupled_->add(s_, coupled_scale_, y);
 }
 
 void ContactDual::add_forces(const std::vector<ContactPair>& pairs, std::vector<Vec3>& f) const {
@@ -37,41 +46,51 @@ void ContactDual::add_forces(const std::vector<ContactPair>& pairs, std::vector<
   }
 }
 
-// (A + C) p on the active set: A = G^T diag(mob) G, C diagonal.
-void ContactDual::apply(const std::vector<ContactPair>& pairs, const std::vector<double>& p, std::vector<double>& out,
-                        const std::vector<double>& mob) {
-  for (std::size_t a = 0; a < act_.size(); ++a) {
-    const ContactPair& c = pairs[act_[a]];
-    s_[c.i].setZero();
-    if (!c.wall) s_[c.k].setZero();
-  }
-  for (std::size_t a = 0; a < act_.size(); ++a) {
-    const ContactPair& c = pairs[act_[a]];
-    const Vec3 g = p[a] * n_[act_[a]];
-    s_[c.i] += mob[c.i] * g;
-    if (!c.wall) s_[c.k] -= mob[c.k] * g;
+// (A + C) p on the active set: A = G^T M G, C diagonal. With a coupled
+// mobility M = diag(mob) + s C moves every particle that shares fluid with
+// an active contact, so the product goes through move(); without, only the
+// particles of active contacts move.
+void ContactDual::apply(const std::vector<ContactPair>& pairs, const std::vector<double>& p,
+                        std::vector<double>& out) {
+  const std::vector<double>& mob = *mob_;
+  if (coupled_) {
+    std::fill(disp_.begin(), disp_.end(), Vec3::Zero());
+    move(pairs, p, true, disp_);
+  } else {
+    for (std::size_t a = 0; a < act_.size(); ++a) {
+      const ContactPair& c = pairs[act_[a]];
+      disp_[c.i].setZero();
+      if (!c.wall) disp_[c.k].setZero();
+    }
+    for (std::size_t a = 0; a < act_.size(); ++a) {
+      const ContactPair& c = pairs[act_[a]];
+      const Vec3 g = p[a] * n_[act_[a]];
+      disp_[c.i] += mob[c.i] * g;
+      if (!c.wall) disp_[c.k] -= mob[c.k] * g;
+    }
   }
   out.resize(act_.size());
   for (std::size_t a = 0; a < act_.size(); ++a) {
     const std::uint32_t e = act_[a];
     const ContactPair& c = pairs[e];
-    const Vec3 rel = c.wall ? s_[c.i] : Vec3(s_[c.i] - s_[c.k]);
+    const Vec3 rel = c.wall ? disp_[c.i] : Vec3(disp_[c.i] - disp_[c.k]);
     out[a] = n_[e].dot(rel) + comp_[e] * p[a];
   }
 }
 
-long ContactDual::solve_cg(const std::vector<ContactPair>& pairs, double rtol, const std::vector<double>& mob) {
+long ContactDual::solve_cg(const std::vector<ContactPair>& pairs, double rtol) {
   const std::size_t m = act_.size();
+  const std::vector<double>& mob = *mob_;
   diag_.resize(m);
   r_.resize(m);
   for (std::size_t a = 0; a < m; ++a) {
     const ContactPair& c = pairs[act_[a]];
-    diag_[a] = mob[c.i] + (c.wall ? 0.0 : mob[c.k]) + comp_[act_[a]];
+    diag_[a] = mob[c.i] + (c.wall ? 0.0 : mob[c.k]) + comp_[act_[a]] + (coupled_ ? crel_[act_[a]] : 0.0);
     r_[a] = rhs_[act_[a]];
   }
   return pcg(
       r_, rtol, 10 * static_cast<long>(m) + 10,
-      [&](const std::vector<double>& p, std::vector<double>& out) { apply(pairs, p, out, mob); },
+      [&](const std::vector<double>& p, std::vector<double>& out) { apply(pairs, p, out); },
       [&](const std::vector<double>& r, std::vector<double>& z) {
         z.resize(r.size());
         for (std::size_t a = 0; a < r.size(); ++a) z[a] = r[a] / diag_[a];
@@ -83,8 +102,12 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
                                 const std::vector<Vec3>& x_start, const WallParticles& walls_start,
                                 const WallParticles& walls, const Box& box,
                                 double radius, double hertz_k, const std::vector<double>& mob,
-                                const NewtonOptions& opt, std::vector<Vec3>& y) {
+                                MobilityCoupling* coupled, double coupled_scale, const NewtonOptions& opt,
+                                std::vector<Vec3>& y) {
   const std::size_t np = pairs.size();
+  mob_ = &mob;
+  coupled_ = coupled;
+  coupled_scale_ = coupled_scale;
   const double two_r = 2.0 * radius;
   const MinImageYZ mi(box);
   lambda_.resize(np);
@@ -92,6 +115,16 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
   comp_.resize(np);
   rhs_.resize(np);
   s_.resize(y.size());
+  disp_.resize(y.size());
+  if (coupled_) {  // s (C_ii + C_kk - 2 C_ik) of each candidate: the diagonal of s G^T C G (Jacobi)
+    crel_.resize(np);
+    for (std::size_t c = 0; c < np; ++c) {
+      const ContactPair& pc = pairs[c];
+      double v = coupled_->diagonal(pc.i);
+      if (!pc.wall) v += coupled_->diagonal(pc.k) - 2.0 * coupled_->coupling(pc.i, pc.k);
+      crel_[c] = coupled_scale_ * std::max(0.0, v);
+    }
+  }
   // Warm start: the Hertz forces at x_start, along its normals.
   for (std::size_t c = 0; c < np; ++c) {
     const Vec3 r = pair_vector(pairs[c], x_start, walls_start, mi);
@@ -99,13 +132,13 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
     n_[c] = r / rn;
     lambda_[c] = hertz_force(two_r - rn, hertz_k);
   }
-  positions(pairs, b, mob, y);
+  y = b;
+  move(pairs, lambda_, false, y);
   const double k23 = std::cbrt(hertz_k * hertz_k);  // k^{2/3}
   NewtonResult res;
   for (res.iterations = 1; res.iterations <= opt.max_iterations; ++res.iterations) {
     // Residuals at y, normals updated to y; y_next = b + M G(y) lambda.
     act_.clear();
-    y_next_ = b;
     double worst = 0;
     for (std::size_t c = 0; c < np; ++c) {
       const ContactPair& pc = pairs[c];
@@ -113,11 +146,6 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
       const double rn = r.norm(), h = two_r - rn;
       n_[c] = r / rn;
       if (lambda_[c] <= 0 && h <= 0) continue;  // open and staying open
-      if (lambda_[c] > 0) {
-        const Vec3 f = lambda_[c] * n_[c];
-        y_next_[pc.i] += mob[pc.i] * f;
-        if (!pc.wall) y_next_[pc.k] -= mob[pc.k] * f;
-      }
       const double h_lambda = std::cbrt(lambda_[c] * lambda_[c]) / k23;  // (lambda/k)^{2/3}
       const double phi = h - h_lambda;  // the Hertz law's residual as an overlap
       rhs_[c] = phi;
@@ -127,10 +155,12 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
       act_.push_back(static_cast<std::uint32_t>(c));
       if (std::abs(phi) > worst) worst = std::abs(phi), res.worst = pc.i;
     }
+    y_next_ = b;
+    move(pairs, lambda_, false, y_next_);
     // y was placed with the normals of the last iterate; with the normals
     // just updated, y - y_next = r_y. Newton on (y, lambda) with r_y
     // eliminated: (A + C) dlambda = phi + G^T r_y, and the next y is
-    // y_next + diag(mob) G(y) dlambda. Without the G^T r_y term the normals
+    // y_next + M G(y) dlambda. Without the G^T r_y term the normals
     // converge only linearly (30 % more iterations).
     for (auto c : act_) {
       const ContactPair& pc = pairs[c];
@@ -145,16 +175,16 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
       res.converged = true;
       return res;
     }
-    res.linear_iterations += solve_cg(pairs, opt.linear_rtol, mob);
+    res.linear_iterations += solve_cg(pairs, opt.linear_rtol);
     y.swap(y_next_);
+    dq_.resize(act_.size());
     for (std::size_t a = 0; a < act_.size(); ++a) {
       const std::uint32_t c = act_[a];
       const double updated = std::max(0.0, lambda_[c] + d_[a]);
-      const Vec3 f = (updated - lambda_[c]) * n_[c];
+      dq_[a] = updated - lambda_[c];
       lambda_[c] = updated;
-      y[pairs[c].i] += mob[pairs[c].i] * f;
-      if (!pairs[c].wall) y[pairs[c].k] -= mob[pairs[c].k] * f;
     }
+    move(pairs, dq_, true, y);
   }
   res.iterations = opt.max_iterations;
   return res;

@@ -51,11 +51,11 @@ ImplicitStepper::Attempt ImplicitStepper::attempt(double dt, const ImplicitDrift
   const bool bdf2 = opt_.order == 2 && history_ >= 1;
   const double om = dt / dt_;
   const double c = bdf2 ? (1 + om) / (1 + 2 * om) : 1.0;
-  const bool parcel = !d.inv_mass.empty(), accelerating = !d.w1.empty();
+  const bool accelerating = !d.w1.empty();
   b_.resize(n);
   mob_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
-    mob_[i] = c * dt * (d.inv_gamma[i] + (parcel ? dt * d.inv_mass[i] : 0.0));
+    mob_[i] = c * dt * d.inv_gamma[i];
     const Vec3 w = bdf2 ? Vec3((1 + om) * d.w0[i] - om * w_prev_[i]) : d.w0[i];
     const Vec3 drift = accelerating ? Vec3(w + dt * d.w1[i]) : w;
     if (bdf2) {
@@ -70,9 +70,10 @@ ImplicitStepper::Attempt ImplicitStepper::attempt(double dt, const ImplicitDrift
   Attempt a;
   if (opt_.formulation == ContactFormulation::dual) {
     // Starts from the contact forces at x_n (walls at t_n).
-    a.newton = dual_.solve(candidates_, b_, x0_, walls0_, walls, box, p_.radius, p_.hertz_k, mob_, nopt, f.x);
+    a.newton = dual_.solve(candidates_, b_, x0_, walls0_, walls, box, p_.radius, p_.hertz_k, mob_, d.coupling,
+                           c * dt * dt, nopt, f.x);
   } else {
-    if (parcel || std::any_of(d.inv_gamma.begin(), d.inv_gamma.end(),
+    if (d.coupling || std::any_of(d.inv_gamma.begin(), d.inv_gamma.end(),
                               [&](double g) { return g != d.inv_gamma.front(); }))
       throw InputError("numerics.implicit_formulation", "primal", "",
                        "the primal contact solver needs one mobility for all particles (model dem_stokes)");

@@ -81,7 +81,7 @@ double expected_overlap(const DemParams& p, IntegratorId scheme) {
   return std::max(h_load, hertz_max_overlap(0.5 * p.mass, p.impact_speed, p.hertz_k));
 }
 
-std::vector<StabilityLimit> dem_limits(const DemParams& p, const SceneConfig& c, IntegratorId scheme) {
+std::vector<StabilityLimit> dem_limits(const DemParams& p, double gap, IntegratorId scheme) {
   constexpr double inf = std::numeric_limits<double>::infinity();
   std::vector<StabilityLimit> out;
   const double h = expected_overlap(p, scheme);
@@ -107,7 +107,7 @@ std::vector<StabilityLimit> dem_limits(const DemParams& p, const SceneConfig& c,
       out.push_back({"dipole stability", p.gamma * p.radius / p.contact_force,
                      "explicit dipoles, aligning mode of a chain: gamma R / F_contact"});
     if (p.shear_rate > 0)
-      out.push_back({"contact margin", 0.5 * k_contact_margin_over_radius * p.radius / (p.shear_rate * 0.5 * c.gap),
+      out.push_back({"contact margin", 0.5 * k_contact_margin_over_radius * p.radius / (p.shear_rate * 0.5 * gap),
                      "walls move at most half the candidate margin (" + fmt(k_contact_margin_over_radius) +
                          " R) per step"});
     return out;
@@ -119,24 +119,18 @@ std::vector<StabilityLimit> dem_limits(const DemParams& p, const SceneConfig& c,
     out.push_back({"magnetic motion", k_frac * p.radius * p.gamma / (2.0 * p.contact_force),
                    "5 % of R per step at the contact force"});
   if (p.shear_rate > 0)
-    out.push_back({"shear (wall motion)", k_frac * p.radius / (p.shear_rate * 0.5 * c.gap),
+    out.push_back({"shear (wall motion)", k_frac * p.radius / (p.shear_rate * 0.5 * gap),
                    "5 % of R per step at the wall speed"});
   return out;
 }
 
-double smallest(const std::vector<StabilityLimit>& limits) { return binding(limits).dt; }
-
 IntegratorId auto_integrator(const std::vector<StabilityLimit>& verlet_exp,
                              const std::vector<StabilityLimit>& overdamped,
-                             const std::vector<StabilityLimit>& implicit) {
+                             const std::vector<StabilityLimit>& implicit, double stokes_number) {
+  if (stokes_number > k_inertialess_max_stokes) return IntegratorId::verlet_exp;
   const double explicit_dt = std::max(smallest(verlet_exp), smallest(overdamped));
   if (k_implicit_preference * explicit_dt < smallest(implicit)) return IntegratorId::implicit;
   return smallest(verlet_exp) >= smallest(overdamped) ? IntegratorId::verlet_exp : IntegratorId::overdamped;
-}
-
-const StabilityLimit& binding(const std::vector<StabilityLimit>& limits) {
-  return *std::min_element(limits.begin(), limits.end(),
-                           [](const auto& a, const auto& b) { return a.dt < b.dt; });
 }
 
 double critical_overlap(const DemParams& p, IntegratorId scheme, double dt) {

@@ -38,6 +38,13 @@ void CoupledModel::save(ArchiveWriter& out) const {
   out.put(external_impulse_);
   out.put(time_);
   out.put(steps_);
+  out.put(eps_seen_min_);
+  out.put(eps_seen_max_);
+  out.put(clamped_steps_);
+  if (implicit_) {
+    implicit_->save(out);
+    out.put(fluid_substeps_);
+  }
 }
 
 void CoupledModel::load(ArchiveReader& in) {
@@ -57,6 +64,13 @@ void CoupledModel::load(ArchiveReader& in) {
   in.get(external_impulse_);
   in.get(time_);
   in.get(steps_);
+  in.get(eps_seen_min_);
+  in.get(eps_seen_max_);
+  in.get(clamped_steps_);
+  if (implicit_) {
+    implicit_->load(in);
+    in.get(fluid_substeps_);
+  }
   fluid_.time = time_;
   fluid_.steps = steps_;
   refresh(fluid_);  // as at the end of step()

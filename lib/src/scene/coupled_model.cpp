@@ -2,17 +2,21 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <sstream>
 
 #include "mrf/coupling/drag_laws.hpp"
 #include "mrf/error.hpp"
-#include "mrf/fluid/couette_sph.hpp"
+#include "mrf/scene/fluid_only.hpp"
 #include "mrf/fluid/fluid_observables.hpp"
 #include "mrf/fluid/kernel.hpp"
 #include "mrf/fluid/viscosity.hpp"
 #include "mrf/fluid/wcsph.hpp"
 #include "mrf/integrate/stability.hpp"
 #include "mrf/integrate/steps.hpp"
+#include "mrf/scene/dem_model.hpp"
+#include "mrf/scene/run.hpp"
 
 namespace mrf {
 
@@ -64,17 +68,46 @@ double coupled_viscous_limit(const FluidCell& f, double eps_min) {
   return 0.125 * f.h * f.h * eps_min * f.params.density / (f.params.viscosity * f.viscous_scale);
 }
 
+namespace {
+CoupledStepping inertial_stepping(double dt_fluid, int substeps) {
+  CoupledStepping s;
+  s.dt_fluid = dt_fluid;
+  s.substeps = substeps;
+  return s;
+}
+}  // namespace
+
+const char* to_string(CoupledScheme s) { return s == CoupledScheme::inertial ? "inertial" : "inertialess"; }
+
 CoupledModel::CoupledModel(ShearCell cell, const DemParams& params, FluidCell fluid, CoupledDrag law,
                            double dt_fluid, int substeps)
-    : cell_(std::move(cell)), p_(params), fluid_(std::move(fluid)), law_(law), dt_(dt_fluid), substeps_(substeps) {
-  if (!(dt_ > 0) || substeps_ < 1) throw InputError("numerics.dt", std::to_string(dt_), "", "coupled step must be > 0");
+    : CoupledModel(std::move(cell), params, std::move(fluid), law, inertial_stepping(dt_fluid, substeps)) {}
+
+CoupledModel::CoupledModel(ShearCell cell, const DemParams& params, FluidCell fluid, CoupledDrag law,
+                           const CoupledStepping& stepping)
+    : cell_(std::move(cell)),
+      p_(params),
+      fluid_(std::move(fluid)),
+      law_(law),
+      dt_(stepping.dt_fluid),
+      substeps_(stepping.substeps),
+      stepping_(stepping) {
+  const bool inertialess = stepping_.scheme == CoupledScheme::inertialess;
+  if (!(dt_ > 0) || substeps_ < 1 || (inertialess && !(stepping_.dt_max > 0)))
+    throw InputError("numerics.dt", std::to_string(inertialess ? stepping_.dt_max : dt_), "",
+                     "coupled step must be > 0");
   const std::size_t n = cell_.free.size();
   cell_.free.v.resize(n, Vec3::Zero());
   cell_.free.f.resize(n, Vec3::Zero());
-  const double two_r = 2.0 * p_.radius;
-  const double ff_range = p_.dipole_pref > 0 ? std::max(p_.dipole_cutoff, two_r) : two_r;
-  lists_ = make_pair_lists(ff_range, cell_.walls.size() > 0 ? two_r : 0.0, p_.skin);
-  overlap_limit_ = critical_overlap(p_, IntegratorId::verlet_exp, dt_dem());
+  double near_reach = 0;
+  lists_ = dem_pair_lists(p_, cell_.box, inertialess, cell_.walls.size() > 0, near_reach);
+  sph_pairs_.skin = stepping_.sph_skin;
+  if (inertialess) {
+    implicit_.emplace(stepping_.implicit, implicit_contact_params(p_, cell_.box), stepping_.dt_max, near_reach);
+    overlap_limit_ = p_.radius;
+  } else {
+    overlap_limit_ = critical_overlap(p_, IntegratorId::verlet_exp, dt_dem());
+  }
   parcel_.u.assign(n, Vec3::Zero());
   parcel_.impulse.assign(n, Vec3::Zero());
   // The rest state: each SPH particle's intrinsic density at the start is its
@@ -88,10 +121,50 @@ CoupledModel::CoupledModel(ShearCell cell, const DemParams& params, FluidCell fl
     fluid_.fluid.rest_density[a] = fluid_.fluid.rho[a] / fluid_.fluid.eps[a];
   update_pressures(fluid_);
   update_dem_forces();
+  momentum0_ = momentum();
+}
+
+StepSample CoupledModel::sample() const {
+  return {sums_.dem, sums_.fluid_stress, sums_.fluid_virial + sums_.exchange_virial, implicit_ ? implicit_->dt() : 1.0};
+}
+
+std::string CoupledModel::progress() const {
+  char b[48];
+  std::snprintf(b, sizeof b, "eps %.3f-%.3f", sums_.eps_min, sums_.eps_max);
+  return b;
+}
+
+void CoupledModel::finish(RunSummary& s) const {
+  const Vec3 drift = momentum() - momentum0_ - external_impulse_;
+  const double scale = fluid_.mass * static_cast<double>(fluid_.fluid.size()) * std::abs(p_.shear_rate) * 0.5 *
+                       cell_.box.gap;  // the fluid's momentum at the wall speed
+  s.extra["porosity_min"] = eps_seen_min_;
+  s.extra["porosity_max"] = eps_seen_max_;
+  s.extra["steps_with_clamped_porosity"] = static_cast<double>(clamped_steps_);
+  s.extra["momentum_drift_N_s"] = drift.norm();
+  s.extra["momentum_drift_relative"] = scale > 0 ? drift.norm() / scale : 0.0;
+  s.extra["sph_wall_reflections"] = static_cast<double>(sums_.wall_reflections);
+  if (implicit_) {
+    const ImplicitCounters& ic = implicit_->counters();
+    s.extra["implicit_rejected_steps"] = static_cast<double>(ic.rejected);
+    s.extra["implicit_newton_failures"] = static_cast<double>(ic.newton_failures);
+    s.extra["implicit_newton_iterations"] = static_cast<double>(ic.newton_iterations);
+    s.extra["implicit_linear_iterations"] = static_cast<double>(ic.linear_iterations);
+    s.extra["implicit_dt_min"] = ic.dt_min;
+    s.extra["implicit_dt_max"] = ic.dt_max;
+    s.extra["implicit_dt_mean"] = time_ / static_cast<double>(std::max(1L, steps_));
+    s.extra["fluid_steps"] = static_cast<double>(fluid_substeps_);
+    s.extra["sph_pair_builds"] = static_cast<double>(sph_pairs_.builds);
+    if (stepping_.implicit_viscosity) s.extra["viscous_cg_iterations"] = static_cast<double>(viscous_iterations_);
+  } else {
+    s.steps = steps_ * substeps_;  // DEM sub-steps
+    s.extra["fluid_steps"] = static_cast<double>(steps_);
+  }
 }
 
 Vec3 CoupledModel::momentum() const {
-  return p_.mass * sum_of(cell_.free.v) + fluid_.mass * sum_of(fluid_.fluid.v);
+  const Vec3 fluid = fluid_.mass * sum_of(fluid_.fluid.v);
+  return implicit_ ? fluid : Vec3(p_.mass * sum_of(cell_.free.v) + fluid);
 }
 
 // Pairs, porosity and pressures for the current DEM and SPH positions.
@@ -223,47 +296,56 @@ void CoupledModel::dem_substep() {
   external_impulse_ += 0.5 * h * (dem_old + sum_of(f.f)) + (h * static_cast<double>(f.size())) * body_force_;
 }
 
-void CoupledModel::step() {
-  const std::size_t n = cell_.free.size(), nf = fluid_.fluid.size();
+std::vector<Vec3> CoupledModel::fluid_acceleration(bool viscous, bool sample) {
   // Fluid forces of the current state (explicit SPH, REFERENCE §5).
   std::vector<Vec3> a = external_acceleration(fluid_);
   add_pressure_acceleration(fluid_, a);
-  add_viscous_acceleration(fluid_, a);
-  sums_.fluid_stress = wall_shear_stress(fluid_).tau;
-  sums_.fluid_virial = -fluid_pair_virial_xz(fluid_) / fluid_.box.volume();
-  prepare_coupling(a);
+  if (viscous) add_viscous_acceleration(fluid_, a);
+  if (sample) {
+    sums_.fluid_stress = wall_shear_stress(fluid_).tau;
+    sums_.fluid_virial = -fluid_pair_virial_xz(fluid_) / fluid_.box.volume();
+  }
+  return a;
+}
 
-  sums_.dem = PairSums{};
-  f_old_.resize(n);
-  f_new_.resize(n);
-  for (int k = 0; k < substeps_; ++k) dem_substep();
-  const double inv = 1.0 / substeps_;
-  sums_.dem.wall_fz[0] *= inv;
-  sums_.dem.wall_fz[1] *= inv;
-  sums_.dem.virial_mag_xz *= inv;
-  sums_.dem.virial_con_xz *= inv;
-
-  // Exchange: the fluid receives minus the drag impulse and minus the
-  // buoyancy impulse, scattered with the Shepard weights (exact, §6).
-  std::vector<Vec3> exchange(n), kick(nf, Vec3::Zero());
-  for (std::size_t i = 0; i < n; ++i) exchange[i] = parcel_.impulse[i] + dt_ * buoyancy_[i];
-  add_back_coupling(pairs_, exchange, shepard_.s, fluid_.fluid.rho, kick);
+// The fluid receives minus the impulse the particles took from it (drag and
+// buoyancy, N s), scattered with the Shepard weights (exact, §6), as a
+// velocity kick per SPH particle; and the exchange virial of that force.
+void CoupledModel::exchange_with_fluid(const std::vector<Vec3>& impulse, std::vector<Vec3>& kick, double dt) {
+  kick.assign(fluid_.fluid.size(), Vec3::Zero());
+  add_back_coupling(pairs_, impulse, shepard_.s, fluid_.fluid.rho, kick);
   double exchange_virial = 0.0;  // force on i from a: E_i/dt x scatter weight (m/rho_a) W_ia / s_i
   for (const CouplingPair& q : pairs_)
-    exchange_virial += (cell_.free.x[q.i].x() - fluid_.fluid.x[q.a].x()) * exchange[q.i].z() *
+    exchange_virial += (cell_.free.x[q.i].x() - fluid_.fluid.x[q.a].x()) * impulse[q.i].z() *
                        (fluid_.mass * q.w / (fluid_.fluid.rho[q.a] * shepard_.s[q.i]));
-  sums_.exchange_virial = -exchange_virial / (dt_ * fluid_.box.volume());
+  sums_.exchange_virial = -exchange_virial / (dt * fluid_.box.volume());
+}
+
+// The SPH particles over dt: v += dt a + kick (and the viscous term by
+// backward Euler where `implicit_viscosity`), x += dt v; the wall particles
+// move with the walls. `a` holds the accelerations at the start.
+void CoupledModel::advance_fluid(double dt, const std::vector<Vec3>& kick, std::vector<Vec3>& a,
+                                 bool implicit_viscosity) {
+  const std::size_t nf = fluid_.fluid.size();
   Vec3 fluid_force = Vec3::Zero();
   for (std::size_t b = 0; b < nf; ++b) {
-    fluid_.fluid.v[b] += dt_ * a[b] + kick[b];
+    fluid_.fluid.v[b] += dt * a[b] + kick[b];
     fluid_force += a[b];
   }
-  external_impulse_ += (dt_ * fluid_.mass) * fluid_force;  // SPH pair terms cancel: walls + body force
+  external_impulse_ += (dt * fluid_.mass) * fluid_force;  // SPH pair terms cancel: walls + body force
+  if (implicit_viscosity) {
+    viscous_iterations_ += solve_implicit_viscosity(fluid_, dt, fluid_.fluid.v).iterations;
+    // The walls' viscous push at the new velocities, summed on its own: what
+    // the fluid-fluid terms leave of the momentum change is the CG residual.
+    Vec3 wall = Vec3::Zero();
+    for (const SphPair& pr : fluid_.pairs.fluid_wall) wall += wall_viscous_acceleration(fluid_, pr);
+    external_impulse_ += (dt * fluid_.mass) * wall;
+  }
+  const double half = 0.5 * fluid_.box.gap;
   for (std::size_t b = 0; b < nf; ++b) {
-    fluid_.fluid.x[b] += dt_ * fluid_.fluid.v[b];
+    fluid_.fluid.x[b] += dt * fluid_.fluid.v[b];
     fluid_.box.wrap(fluid_.fluid.x[b]);
     Vec3& x = fluid_.fluid.x[b];
-    const double half = 0.5 * fluid_.box.gap;
     if (std::abs(x.x()) >= half && std::abs(x.x()) < 2.0 * half) {
       // The SPH wall is soft (a pressure layer): at cell Reynolds numbers of
       // ~100 (Mn ~ 1) particles dragged by fast wall-bounced spheres can
@@ -278,21 +360,114 @@ void CoupledModel::step() {
     if (!x.allFinite() || !fluid_.fluid.v[b].allFinite() || std::abs(x.x()) >= half) {
       std::ostringstream s;
       s << "SPH particle " << b << (x.allFinite() ? " crossed a wall plane" : " became non-finite")
-        << " at fluid step " << steps_ << " (t = " << time_ << " s): x = (" << x.transpose() << ") m, v = ("
+        << " at step " << steps_ << " (t = " << time_ << " s): x = (" << x.transpose() << ") m, v = ("
         << fluid_.fluid.v[b].transpose() << ") m/s";
       throw NumericalError(s.str());
     }
   }
   for (std::size_t w = 0; w < fluid_.wall.size(); ++w) {
-    fluid_.wall.x[w] += dt_ * fluid_.wall.v[w];
+    fluid_.wall.x[w] += dt * fluid_.wall.v[w];
     fluid_.box.wrap(fluid_.wall.x[w]);
   }
+}
+
+void CoupledModel::step() {
+  if (implicit_) return inertialess_step();
+  const std::size_t n = cell_.free.size();
+  std::vector<Vec3> a = fluid_acceleration(true, true);
+  prepare_coupling(a);
+
+  sums_.dem = PairSums{};
+  f_old_.resize(n);
+  f_new_.resize(n);
+  for (int k = 0; k < substeps_; ++k) dem_substep();
+  const double inv = 1.0 / substeps_;
+  sums_.dem.wall_fz[0] *= inv;
+  sums_.dem.wall_fz[1] *= inv;
+  sums_.dem.virial_mag_xz *= inv;
+  sums_.dem.virial_con_xz *= inv;
+
+  std::vector<Vec3> exchange(n), kick;
+  for (std::size_t i = 0; i < n; ++i) exchange[i] = parcel_.impulse[i] + dt_ * buoyancy_[i];
+  exchange_with_fluid(exchange, kick, dt_);
+  advance_fluid(dt_, kick, a, false);
   time_ += dt_;
   fluid_.time = time_;
   ++steps_;
   fluid_.steps = steps_;
   refresh(fluid_);
   update_coupling_pairs();
+  tally();
+}
+
+// Inertialess particles: force balance drag + buoyancy + F_c + F_nc + body = 0.
+void CoupledModel::inertialess_step() {
+  auto& f = cell_.free;
+  const std::size_t n = f.size();
+  const bool implicit_viscosity = stepping_.implicit_viscosity;
+  // the coupling sees the whole fluid force, the explicit step its non-viscous part
+  std::vector<Vec3> a = fluid_acceleration(true, true);
+  prepare_coupling(a);
+  if (implicit_viscosity) a = fluid_acceleration(false, false);
+  const std::vector<Vec3>& fc = implicit_->begin_step(lists_, f, cell_.walls, cell_.box);
+  drift_.w0.resize(n);
+  drift_.w1.resize(n);
+  drift_.inv_gamma.resize(n);
+  response_.set(n, pairs_, shepard_.s, fluid_.fluid.rho, fluid_.mass);
+  drift_.coupling = &response_;
+  std::vector<Vec3> f_nc(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    f_nc[i] = f.f[i] - fc[i] + body_force_;  // non-contact, non-hydrodynamic force at x_n (N)
+    drift_.inv_gamma[i] = 1.0 / coupling_.gamma[i];
+    drift_.w0[i] = u_at_[i] + drift_.inv_gamma[i] * (f_nc[i] + buoyancy_[i]);
+    // The fluid at the particle feels its own forces (coupling_.g adds back
+    // the reaction of the buoyancy, which the particle passes on with the
+    // rest) and, through C, what every particle passes to it.
+    drift_.w1[i] = coupling_.g[i] + coupling_.inv_mass[i] * buoyancy_[i];
+  }
+  response_.add(f_nc, 1.0, drift_.w1);
+  const double dt = implicit_->advance(drift_, f, cell_.walls, cell_.box, time_, steps_);
+  lists_.wall_travel += std::abs(p_.shear_rate) * 0.5 * cell_.box.gap * dt;
+  implicit_->contact_forces_end(f, cell_.walls, cell_.box, fc_end_);
+  // What the fluid gave the particles (drag + buoyancy) is minus what they
+  // pass on: -(F_c + F_nc + body) dt per particle.
+  std::vector<Vec3> exchange(n), kick;
+  Vec3 pushed = Vec3::Zero();
+  for (std::size_t i = 0; i < n; ++i) {
+    exchange[i] = -dt * (fc_end_[i] + f_nc[i]);
+    pushed += fc_end_[i];
+  }
+  // Pair forces cancel: what is left of the particles' push is the walls'
+  // contacts and the body force (the dipole pairs cancel in f_nc as well).
+  external_impulse_ += dt * (pushed + static_cast<double>(n) * body_force_);
+  exchange_with_fluid(exchange, kick, dt);
+  // SPH sub-steps of at most dt_fluid, the kick spread evenly; the porosity
+  // of the SPH particles is held over the step.
+  const int k = std::max(1, static_cast<int>(std::ceil(dt / stepping_.dt_fluid - 1e-9)));
+  const double h = dt / k;
+  for (auto& q : kick) q /= k;
+  const double t0 = time_;
+  for (int s = 0; s < k; ++s) {
+    if (s > 0) a = fluid_acceleration(!implicit_viscosity, false);
+    advance_fluid(h, kick, a, implicit_viscosity);
+    time_ = t0 + (s + 1) * h;
+    refresh(fluid_, sph_pairs_);
+  }
+  time_ = t0 + dt;
+  fluid_substeps_ += k;
+  fluid_.time = time_;
+  ++steps_;
+  fluid_.steps = steps_;
+  update_coupling_pairs();
+  sums_.dem = PairSums{};
+  update_dem_forces();
+  tally();
+}
+
+void CoupledModel::tally() {
+  eps_seen_min_ = std::min(eps_seen_min_, sums_.eps_min);
+  eps_seen_max_ = std::max(eps_seen_max_, sums_.eps_max);
+  clamped_steps_ += sums_.eps_clamped > 0 ? 1 : 0;
 }
 
 }  // namespace mrf

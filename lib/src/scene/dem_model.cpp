@@ -6,8 +6,10 @@
 #include <string>
 
 #include "mrf/error.hpp"
+#include "mrf/observe/stress.hpp"
 #include "mrf/forces/hertz.hpp"
 #include "mrf/integrate/steps.hpp"
+#include "mrf/scene/run.hpp"
 
 namespace mrf {
 
@@ -18,27 +20,35 @@ constexpr double k_implicit_skin_over_radius = 0.4;
 constexpr double k_near_skin_over_radius = 1.0;
 }  // namespace
 
+DemPairLists dem_pair_lists(const DemParams& p, const Box& box, bool implicit, bool walls, double& near_reach) {
+  const double two_r = 2.0 * p.radius;
+  const double contact_reach = implicit ? two_r + k_contact_margin_over_radius * p.radius : two_r;
+  const double ff_range = p.dipole_pref > 0 ? std::max(p.dipole_cutoff, contact_reach) : contact_reach;
+  // An implicit step moves particles up to half the contact margin, so a
+  // 0.2 R skin would be rebuilt almost every step: it is raised to 0.4 R
+  // where the minimum image allows.
+  double skin = p.skin;
+  if (implicit)
+    skin = std::max(skin, std::min(k_implicit_skin_over_radius * p.radius, 0.5 * std::min(box.ly, box.lz) - ff_range));
+  near_reach = std::min(ff_range, contact_reach + k_near_skin_over_radius * p.radius);
+  return make_pair_lists(ff_range, walls ? contact_reach : 0.0, skin);
+}
+
+ImplicitContactParams implicit_contact_params(const DemParams& p, const Box& box) {
+  return {p.radius, p.hertz_k, p.shear_rate, std::abs(p.shear_rate) * 0.5 * box.gap};
+}
+
 DemModel::DemModel(ShearCell cell, const DemParams& params, IntegratorId scheme, double dt)
     : cell_(std::move(cell)), p_(params), scheme_(scheme), dt_(dt) {
   if (scheme_ == IntegratorId::automatic)
     throw InputError("numerics.integrator", to_string(scheme_), "", "choose the integrator before building the model");
   cell_.free.v.resize(cell_.free.size(), Vec3::Zero());
   cell_.free.f.resize(cell_.free.size(), Vec3::Zero());
-  const double two_r = 2.0 * p_.radius;
-  const double contact_reach =
-      scheme_ == IntegratorId::implicit ? two_r + k_contact_margin_over_radius * p_.radius : two_r;
-  const double ff_range = p_.dipole_pref > 0 ? std::max(p_.dipole_cutoff, contact_reach) : contact_reach;
-  // An implicit step moves particles up to half the contact margin, so a
-  // 0.2 R skin would be rebuilt almost every step: it is raised to 0.4 R
-  // where the minimum image allows.
-  double skin = p_.skin;
-  if (scheme_ == IntegratorId::implicit)
-    skin = std::max(skin, std::min(k_implicit_skin_over_radius * p_.radius,
-                                   0.5 * std::min(cell_.box.ly, cell_.box.lz) - ff_range));
-  lists_ = make_pair_lists(ff_range, cell_.walls.size() > 0 ? contact_reach : 0.0, skin);
-  if (scheme_ == IntegratorId::implicit) {
-    const ImplicitContactParams ip{p_.radius, p_.hertz_k, p_.shear_rate, std::abs(p_.shear_rate) * 0.5 * cell_.box.gap};
-    implicit_.emplace(ImplicitOptions{}, ip, dt, std::min(ff_range, contact_reach + k_near_skin_over_radius * p_.radius));
+  const bool implicit = scheme_ == IntegratorId::implicit;
+  double near_reach = 0;
+  lists_ = dem_pair_lists(p_, cell_.box, implicit, cell_.walls.size() > 0, near_reach);
+  if (implicit) {
+    implicit_.emplace(ImplicitOptions{}, implicit_contact_params(p_, cell_.box), dt, near_reach);
     drift_.inv_gamma.assign(cell_.free.size(), 1.0 / p_.gamma);
   }
   overlap_limit_ = scheme_ == IntegratorId::implicit ? p_.radius : critical_overlap(p_, scheme_, dt_);
@@ -84,6 +94,23 @@ void DemModel::implicit_step() {
   time_ += dt;
   ++steps_;
   update_forces();
+}
+
+StepSample DemModel::sample() const {
+  const double eta_gdot = imposed_fluid_stress(p_.viscosity, p_.shear_rate);  // the imposed profile transmits it
+  return {sums_, eta_gdot, eta_gdot, implicit_ ? implicit_->dt() : 1.0};
+}
+
+void DemModel::finish(RunSummary& s) const {
+  if (!implicit_) return;
+  const ImplicitCounters& ic = implicit_->counters();
+  s.extra["implicit_rejected_steps"] = static_cast<double>(ic.rejected);
+  s.extra["implicit_newton_failures"] = static_cast<double>(ic.newton_failures);
+  s.extra["implicit_newton_iterations"] = static_cast<double>(ic.newton_iterations);
+  s.extra["implicit_linear_iterations"] = static_cast<double>(ic.linear_iterations);
+  s.extra["implicit_dt_min"] = ic.dt_min;
+  s.extra["implicit_dt_max"] = ic.dt_max;
+  s.extra["implicit_dt_mean"] = time_ / static_cast<double>(std::max(1L, steps_));
 }
 
 void DemModel::check_finite_positions() const {

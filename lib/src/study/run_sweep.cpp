@@ -10,6 +10,7 @@
 
 #include "mrf/error.hpp"
 #include "mrf/scene/dem_params.hpp"
+#include "mrf/scene/build_model.hpp"
 #include "mrf/scene/run.hpp"
 #include "mrf/study/sweep.hpp"
 #include "mrf/vec.hpp"

@@ -86,6 +86,9 @@ Vec3 wall_velocity(const FluidCell& cell, int side);
 // wall pressures at the current positions (pressure from the intrinsic
 // density rho/eps when fluid.eps is set).
 void refresh(FluidCell& cell);
+// The same with the pairs from a Verlet cache (update_pairs, below).
+struct SphPairCache;
+void refresh(FluidCell& cell, SphPairCache& cache);
 
 // Pressures and wall densities from the current densities and porosities,
 // without a new pair search (refresh() ends with it). With porosity the wall
@@ -95,6 +98,24 @@ void refresh(FluidCell& cell);
 void update_pressures(FluidCell& cell);
 
 // Neighbour pairs of the current positions (cell lists, periodic images).
+// `reach` (m): pairs closer than that; default the kernel support 2h.
 SphPairs find_pairs(const FluidCell& cell);
+SphPairs find_pairs(const FluidCell& cell, double reach);
+
+// Verlet candidates of the SPH pairs: the pairs within 2h + skin at the
+// reference positions, each with its separation there. While no particle
+// has moved more than skin/2 (fluid-fluid) or the fluid and wall particles
+// together more than the skin, every pair within 2h is a candidate, and its
+// separation now is r_ab(ref) + d_a - d_b with the displacements d since the
+// reference (minimum image: positions are wrapped in y and z each step).
+struct SphPairCache {
+  double skin = 0;              // m; 0 = search every time
+  SphPairs candidates;
+  std::vector<Vec3> x_fluid, x_wall;  // reference positions
+  long builds = 0;
+};
+
+// cell.pairs for the current positions, from the cache (rebuilt when due).
+void update_pairs(FluidCell& cell, SphPairCache& cache);
 
 }  // namespace mrf

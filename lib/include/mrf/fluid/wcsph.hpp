@@ -16,6 +16,7 @@
 
 #include "mrf/fluid/fluid_cell.hpp"
 #include "mrf/fluid/viscosity.hpp"
+#include "mrf/integrate/limit.hpp"
 
 namespace mrf {
 
@@ -51,19 +52,12 @@ void step(FluidCell& c, double dt);
 // limit; accuracy is first order in dt. Same checks as step().
 ImplicitSolveStats step_implicit(FluidCell& c, double dt);
 
-// One stability limit {name, dt (s)}; a caller prints them at start-up.
-struct SphStepLimit {
-  std::string name;
-  double dt;
-};
-
 // Morris et al. (1997) limits (REFERENCE §5): CFL 0.25 h/(c0 + |v|max),
 // viscous 0.125 h^2/nu (left out when viscosity is implicit) and force
 // 0.25 sqrt(h/|f|max) (left out when there is no force).
-std::vector<SphStepLimit> stability_limits(const FluidCell& c, bool implicit_viscosity);
-
-// The binding (smallest) limit.
-const SphStepLimit& binding_limit(const std::vector<SphStepLimit>& limits);
+std::vector<StabilityLimit> stability_limits(const FluidCell& c, bool implicit_viscosity);
+// The viscous one alone (s): whether it binds decides implicit viscosity.
+double viscous_limit(const FluidCell& c);
 
 // Throws InputError (key numerics.dt) if dt exceeds a limit, naming it.
 void check_time_step(const FluidCell& c, double dt, bool implicit_viscosity);

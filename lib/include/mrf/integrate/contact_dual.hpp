@@ -1,10 +1,10 @@
 // The backward Euler contact step of implicit_contact.hpp solved for the
 // contact forces instead of the positions (the compliance or "dual" form).
 //
-// The step is y = b + M sum_c G_c lambda_c, M = diag(mob_i) the displacement
-// per unit force over the step of each particle (dt/gamma for IMEX Euler in
-// an imposed flow; more where the fluid at the particle yields, see
-// implicit_stepper.hpp), where lambda_c >= 0 is the Hertz force of candidate pair c and G_c puts +n_c on i and -n_c on k (n_c the
+// The step is y = b + M sum_c G_c lambda_c, M = diag(mob_i) + s C the
+// displacement per unit force over the step (dt/gamma for IMEX Euler in an
+// imposed flow; C, optional, couples particles through the fluid they share,
+// integrate/mobility.hpp), where lambda_c >= 0 is the Hertz force of candidate pair c and G_c puts +n_c on i and -n_c on k (n_c the
 // unit vector from k to i at y). The Hertz law, written as a compliance,
 //   phi_c(lambda) = h_c(y(lambda)) - (lambda_c / k)^{2/3} = 0   (lambda_c > 0),
 //   lambda_c = 0 and h_c(y(lambda)) <= 0                        (open),
@@ -25,6 +25,7 @@
 
 #include "mrf/box.hpp"
 #include "mrf/integrate/implicit_contact.hpp"
+#include "mrf/integrate/mobility.hpp"
 #include "mrf/integrate/pcg.hpp"
 #include "mrf/state.hpp"
 
@@ -34,33 +35,37 @@ class ContactDual {
  public:
   // Solves the step for y (out), starting from the forces of the pairs at
   // positions x_start with the walls at walls_start (the last step's contact
-  // forces); `walls` at the end of the step. mob: per particle (m/N). opt.tol
+  // forces); `walls` at the end of the step. mob: per particle (m/N);
+  // coupled (or null) times coupled_scale (m kg/N) the coupled part. opt.tol
   // (m) bounds every overlap residual at convergence; opt.solver is unused.
   NewtonResult solve(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& b,
                      const std::vector<Vec3>& x_start, const WallParticles& walls_start, const WallParticles& walls,
                      const Box& box, double radius, double hertz_k, const std::vector<double>& mob,
-                     const NewtonOptions& opt, std::vector<Vec3>& y);
+                     MobilityCoupling* coupled, double coupled_scale, const NewtonOptions& opt, std::vector<Vec3>& y);
   // Adds the contact forces of the last solve (+n lambda on i, -n lambda on
   // k) to f: pairwise opposite, so their sum over the free particles is the
   // walls' push alone, whatever the Newton tolerance.
   void add_forces(const std::vector<ContactPair>& pairs, std::vector<Vec3>& f) const;
 
  private:
-  void positions(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& b, const std::vector<double>& mob,
-                 std::vector<Vec3>& y) const;  // y = b + M G lambda
+  // y += M G q for the pair values q (all pairs, or the active set)
+  void move(const std::vector<ContactPair>& pairs, const std::vector<double>& q, bool active_only,
+            std::vector<Vec3>& y);
   // (A + C) p on the active set
-  void apply(const std::vector<ContactPair>& pairs, const std::vector<double>& p, std::vector<double>& out,
-             const std::vector<double>& mob);
-  long solve_cg(const std::vector<ContactPair>& pairs, double rtol, const std::vector<double>& mob);
+  void apply(const std::vector<ContactPair>& pairs, const std::vector<double>& p, std::vector<double>& out);
+  long solve_cg(const std::vector<ContactPair>& pairs, double rtol);
 
   // Per candidate pair: force (N), compliance slope (m/N), Newton
   // right-hand side (m), unit normal (k to i; frozen over a linear solve).
-  std::vector<double> lambda_, comp_, rhs_;
+  std::vector<double> lambda_, comp_, rhs_, crel_;
   std::vector<Vec3> n_;
   std::vector<std::uint32_t> act_;           // active pairs
-  std::vector<double> d_, r_, diag_;           // CG on the active set: solution, right-hand side, Jacobi diagonal
+  std::vector<double> d_, r_, diag_, dq_;           // CG on the active set: solution, right-hand side, Jacobi diagonal
   PcgScratch<double> cg_;
-  std::vector<Vec3> s_, y_next_;             // per particle: G p (scratch), positions with the new normals
+  std::vector<Vec3> s_, y_next_, disp_;      // per particle: G q, positions with the new normals, M G q
+  const std::vector<double>* mob_ = nullptr;  // of the current solve
+  MobilityCoupling* coupled_ = nullptr;
+  double coupled_scale_ = 0;
 };
 
 }  // namespace mrf

@@ -3,22 +3,21 @@
 // the imposed Couette flow of model 1 and the SPH carrier of models 2 and 3.
 //
 // Per free particle i the drift over a step of length dt is
-//   dx_i/dt = w0_i + (t - t_n) w1_i + mob_i(dt) F_c,i(x),
-//   mob_i(dt) = 1/gamma_i + dt/M_i,
+//   dx_i/dt = w0_i + (t - t_n) w1_i + F_c,i(x)/gamma_i + (t - t_n) sum_j C_ij F_c,j(x),
 // w0 the explicit part at t_n (flow velocity at the particle plus the
 // non-contact forces over gamma), w1 its rate of change within the step
 // (zero in an imposed flow; for a coupled model the acceleration of the fluid
-// parcel at the particle), gamma_i the drag coefficient and M_i the inertia
-// of the fluid at the particle (1/M_i = 0 in an imposed flow). The Hertz
-// contacts F_c are implicit. Why the parcel term: an inertialess particle
-// passes its whole non-drag force to the fluid through the drag, so the fluid
-// parcel at it accelerates by F/M within the step; taking that into the
-// implicit solve makes the interphase drag relaxation (rate gamma/M, ~1e7 1/s
-// at phi = 0.3) unconditionally stable, as the parcel step of the inertial
-// coupled scheme does (integrate/coupled_steps.hpp).
+// at the particle), gamma_i the drag coefficient and C (optional,
+// integrate/mobility.hpp) how the fluid velocity at i responds to the forces
+// particles pass to it. The Hertz contacts F_c are implicit. Why the C term:
+// an inertialess particle passes its whole non-drag force to the fluid
+// through the drag, so the fluid at it accelerates within the step; taking
+// that into the implicit solve makes the interphase drag relaxation (rate
+// n gamma / (eps rho_f), ~3e7 1/s at phi = 0.3) unconditionally stable, as
+// the parcel step of the inertial coupled scheme does (coupled_steps.hpp).
 //
 // IMEX Euler (order 1) or variable-step IMEX BDF2 (order 2):
-//   y = b + c dt mob(dt) F_c(y),
+//   y = b + c dt (F_c(y)/gamma + dt C F_c(y)),
 //   order 1: b = x_n + dt (w0_n + dt w1_n), c = 1
 //   order 2: omega = dt/dt_{n-1}, c = (1+omega)/(1+2 omega),
 //            b = a1 x_n - a2 x_{n-1} + c dt ((1+omega) w0_n - omega w0_{n-1} + dt w1_n),
@@ -38,6 +37,7 @@
 #include "mrf/box.hpp"
 #include "mrf/integrate/contact_dual.hpp"
 #include "mrf/integrate/implicit_contact.hpp"
+#include "mrf/integrate/mobility.hpp"
 #include "mrf/io/archive.hpp"
 #include "mrf/neighbors/verlet_list.hpp"
 #include "mrf/state.hpp"
@@ -67,13 +67,13 @@ struct ImplicitCounters {
   double dt_min = std::numeric_limits<double>::infinity(), dt_max = 0;  // accepted steps (s)
 };
 
-// The explicit part of one step (see the header comment). w1 and inv_mass
-// may be empty (imposed flow: zero).
+// The explicit part of one step and the mobility (see the header comment).
+// w1 may be empty and coupling null (imposed flow: zero).
 struct ImplicitDrift {
   std::vector<Vec3> w0;           // m/s
   std::vector<Vec3> w1;           // m/s^2
   std::vector<double> inv_gamma;  // 1/gamma_i (s/kg)
-  std::vector<double> inv_mass;   // 1/M_i (1/kg)
+  MobilityCoupling* coupling = nullptr;
 };
 
 // Contact geometry and law of the step: identical spheres of `radius` (m),

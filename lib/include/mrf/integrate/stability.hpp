@@ -5,16 +5,10 @@
 #include <string>
 #include <vector>
 
-#include "mrf/scene/config.hpp"
-#include "mrf/scene/dem_params.hpp"
+#include "mrf/integrate/limit.hpp"
+#include "mrf/params.hpp"
 
 namespace mrf {
-
-struct StabilityLimit {
-  std::string name;
-  double dt;          // s; infinity when the scheme is not bound by it
-  std::string basis;  // how it was computed, for the start-up printout
-};
 
 // Largest stable dt of the verlet_exp scheme (kick / exact drag-drift / kick)
 // for a damped oscillator r'' = -omega^2 r - r'/tau: found from the spectral
@@ -41,12 +35,12 @@ inline constexpr double k_contact_margin_over_radius = 0.4;
 // and drag limits are infinite, and the binding one is the stability of its
 // explicit dipole forces or the wall motion per step that the contact search
 // allows: the largest step the error control may take.
-std::vector<StabilityLimit> dem_limits(const DemParams& p, const SceneConfig& c, IntegratorId scheme);
+// gap (m): wall-centre distance (the walls move at gdot gap / 2).
+std::vector<StabilityLimit> dem_limits(const DemParams& p, double gap, IntegratorId scheme);
 
 // Contact limit for the largest overlap actually seen (checked during a run).
 double contact_limit_at_overlap(const DemParams& p, IntegratorId scheme, double overlap);
 
-double smallest(const std::vector<StabilityLimit>& limits);
 
 // Automatic choice of the integrator (numerics.integrator = "auto"): the
 // explicit scheme whose binding limit is largest (ties to verlet_exp), unless
@@ -59,10 +53,17 @@ double smallest(const std::vector<StabilityLimit>& limits);
 // the walls bind both schemes (Mn >= 0.1 here, St >= 0.03) `auto` keeps the
 // inertial scheme rather than drop the particle inertia for a 2x gain.
 inline constexpr double k_implicit_preference = 5.0;
+// Particles may be taken as inertialess (the implicit scheme, v = u + F/gamma)
+// up to this Stokes number tau_p gdot; above it `auto` keeps their inertia.
+// Measured by scripts/stokes-boundary (small scene, Mn = 1e-2, density
+// varied, 3 seeds; reports/inertia/stokes_boundary.md): model 1's
+// inertialess stress equals the inertial one at St = 3e-3 (-0.1 %, 0.05
+// combined standard errors) and departs by -4.4 % (2.1 errors) at St = 9e-3
+// and -6 % at 3e-2; the bound lies between the two.
+inline constexpr double k_inertialess_max_stokes = 5e-3;
 IntegratorId auto_integrator(const std::vector<StabilityLimit>& verlet_exp,
                              const std::vector<StabilityLimit>& overdamped,
-                             const std::vector<StabilityLimit>& implicit);
-const StabilityLimit& binding(const std::vector<StabilityLimit>& limits);
+                             const std::vector<StabilityLimit>& implicit, double stokes_number);
 
 // Largest overlap (m) whose Hertz stiffness the scheme still integrates
 // stably at time step dt (bisection on the monotone contact limit).

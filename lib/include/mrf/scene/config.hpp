@@ -6,13 +6,13 @@
 #include <optional>
 #include <string>
 
+#include "mrf/params.hpp"
+
 namespace mrf {
 
 enum class ModelId { dem_stokes, demsph_stokes, demsph_dd };
-enum class IntegratorId { automatic, verlet_exp, overdamped, implicit };
 
 const char* to_string(ModelId m);
-const char* to_string(IntegratorId i);
 
 struct SceneConfig {
   // [scene]

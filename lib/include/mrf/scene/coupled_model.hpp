@@ -15,26 +15,57 @@
 // with eps (-grad p) + ...: model A, not model B (pinned by the fixed-bed and
 // sedimentation tests in verification/coupling/).
 //
-// Time stepping, multi-rate: one explicit SPH step of dt_fluid holds
+// Two time-stepping schemes (CoupledStepping):
+//
+// inertial, multi-rate: one explicit SPH step of dt_fluid holds
 // `substeps` DEM sub-steps (the Hertz contact step) that integrate the drag
 // exactly for particle + fluid parcel (integrate/coupled_steps.hpp) with the
 // interpolated fluid velocity, porosity and friction coefficient frozen over
 // the fluid step; the accumulated impulse (and buoyancy) is scattered back to
 // the SPH particles with the same kernel weights (coupling/exchange.hpp), so
 // momentum of particles + fluid + walls is conserved to round-off.
+//
+// inertialess (particle Stokes number small): v_i = u_i + F_i / gamma_i with
+// u_i, eps_i and gamma_i(eps_i) interpolated as above, the Hertz contacts
+// implicit and the dipole forces explicit (integrate/implicit_stepper.hpp,
+// the scheme of model 1, error-controlled steps). The fluid at the particles
+// yields within the step as the scatter and gather of the exchange make it
+// (coupling/fluid_response.hpp), which makes the interphase drag relaxation
+// implicit. An
+// inertialess particle passes its whole non-hydrodynamic force (contacts,
+// dipoles, body force) to the fluid through the drag; that force times the
+// step is scattered back to the SPH particles, so momentum of fluid + walls
+// is conserved to round-off (the particles carry none). The SPH fluid then
+// advances over the step in explicit sub-steps no longer than dt_fluid.
 #pragma once
+#include <optional>
 #include <vector>
 
 #include "mrf/coupling/exchange.hpp"
+#include "mrf/coupling/fluid_response.hpp"
 #include "mrf/fluid/fluid_cell.hpp"
 #include "mrf/integrate/coupled_steps.hpp"
+#include "mrf/integrate/implicit_stepper.hpp"
 #include "mrf/io/archive.hpp"
 #include "mrf/scene/dem_forces.hpp"
+#include "mrf/scene/model.hpp"
 #include "mrf/scene/shear_cell.hpp"
 
 namespace mrf {
 
 enum class CoupledDrag { stokes, di_felice };
+enum class CoupledScheme { inertial, inertialess };
+const char* to_string(CoupledScheme s);
+
+struct CoupledStepping {
+  CoupledScheme scheme = CoupledScheme::inertial;
+  double dt_fluid = 0;    // s: inertial, the fluid step; inertialess, the longest SPH sub-step
+  int substeps = 1;       // inertial: DEM sub-steps per fluid step
+  double dt_max = 0;      // inertialess: longest step (stability bounds of the explicit parts, s)
+  bool implicit_viscosity = false;  // inertialess: SPH viscosity by backward Euler (dt_fluid then the CFL bound)
+  double sph_skin = 0;    // inertialess: Verlet skin of the SPH pairs (m; 0 = search every sub-step)
+  ImplicitOptions implicit;  // inertialess
+};
 
 // Sums over the DEM sub-steps of one fluid step (for the stress observables).
 struct CoupledStepSums {
@@ -51,28 +82,45 @@ struct CoupledStepSums {
   long wall_reflections = 0;             // SPH particles reflected at a wall plane since the start
 };
 
-class CoupledModel {
+class CoupledModel final : public Model {
  public:
   // `fluid` built for the same box (fluid mass already scaled, see
   // build_coupled_fluid). dt_fluid (s) is split into `substeps` DEM sub-steps.
   CoupledModel(ShearCell cell, const DemParams& params, FluidCell fluid, CoupledDrag law, double dt_fluid,
                int substeps);
+  CoupledModel(ShearCell cell, const DemParams& params, FluidCell fluid, CoupledDrag law, const CoupledStepping& s);
 
-  void step();
+  // One fluid step (inertial) or one accepted implicit step (inertialess).
+  void step() override;
+  CoupledScheme scheme() const { return stepping_.scheme; }
+  // Inertialess: the step just taken (s), the implicit scheme's work, and
+  // the stop time the step that would pass it is shortened to.
+  double dt() const override { return implicit_ ? implicit_->dt() : dt_; }
+  const ImplicitCounters& implicit_counters() const { return implicit_->counters(); }
+  void set_stop_time(double t) override {
+    if (implicit_) implicit_->set_stop_time(t);
+  }
+  bool adaptive() const override { return implicit_.has_value(); }
+  StepSample sample() const override;
+  void finish(RunSummary& s) const override;
+  std::string progress() const override;
+  long fluid_substeps() const { return fluid_substeps_; }  // inertialess: SPH sub-steps so far
+  long sph_pair_builds() const { return sph_pairs_.builds; }
+  long viscous_iterations() const { return viscous_iterations_; }  // implicit viscosity: CG iterations so far
 
-  const ShearCell& cell() const { return cell_; }
+  const ShearCell& cell() const override { return cell_; }
   const FluidCell& fluid() const { return fluid_; }
   const DemParams& params() const { return p_; }
-  const DemPairLists& lists() const { return lists_; }
+  const DemPairLists& lists() const override { return lists_; }
   const CoupledStepSums& sums() const { return sums_; }
   double dt_fluid() const { return dt_; }
   double dt_dem() const { return dt_ / substeps_; }
   int substeps() const { return substeps_; }
-  double time() const { return time_; }
-  long steps() const { return steps_; }
+  double time() const override { return time_; }
+  long steps() const override { return steps_; }
   long dem_steps() const { return steps_ * substeps_; }
 
-  // Total momentum of particles + fluid (kg m/s) and the impulse the walls
+  // Total momentum of particles (none when inertialess) + fluid (kg m/s) and the impulse the walls
   // and body forces have given them since the start (N s): momentum() -
   // momentum at start equals external_impulse() to round-off.
   Vec3 momentum() const;
@@ -94,8 +142,8 @@ class CoupledModel {
   // the same scene; until the next step() the accessors of the last step's
   // coupling fields (coupling(), buoyancy(), ...) and sums() other than
   // wall_reflections and the porosity range are not restored.
-  void save(ArchiveWriter& out) const;
-  void load(ArchiveReader& in);
+  void save(ArchiveWriter& out) const override;
+  void load(ArchiveReader& in) override;
 
  private:
   void update_coupling_pairs();
@@ -103,6 +151,13 @@ class CoupledModel {
   void update_dem_forces();
   void dem_substep();
   void check_dem() const;
+  void inertialess_step();
+  void tally();  // run-long porosity records of the step
+  // SPH forces per unit mass (with or without viscosity); `sample` sets the
+  // fluid stress sums of the step
+  std::vector<Vec3> fluid_acceleration(bool viscous, bool sample);
+  void advance_fluid(double dt, const std::vector<Vec3>& kick, std::vector<Vec3>& a, bool implicit_viscosity);
+  void exchange_with_fluid(const std::vector<Vec3>& impulse, std::vector<Vec3>& kick, double dt);
 
   ShearCell cell_;
   DemParams p_;
@@ -125,6 +180,19 @@ class CoupledModel {
   double overlap_limit_;
   double time_ = 0;
   long steps_ = 0;
+  CoupledStepping stepping_;
+  std::optional<ImplicitStepper> implicit_;  // inertialess
+  ImplicitDrift drift_;
+  FluidResponse response_;
+  SphPairCache sph_pairs_;
+  long viscous_iterations_ = 0;
+  // Over the run (checkpointed): porosity range at the SPH particles and the
+  // steps at which some SPH particle sat at the porosity floor.
+  double eps_seen_min_ = 1, eps_seen_max_ = 0;
+  long clamped_steps_ = 0;
+  Vec3 momentum0_ = Vec3::Zero();  // at construction
+  std::vector<Vec3> fc_end_;
+  long fluid_substeps_ = 0;
 };
 
 // The SPH carrier of a coupled scene: build_fluid_cell on the scene box with

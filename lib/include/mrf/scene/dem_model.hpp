@@ -14,39 +14,45 @@
 #include "mrf/integrate/stability.hpp"
 #include "mrf/io/archive.hpp"
 #include "mrf/scene/dem_forces.hpp"
+#include "mrf/scene/model.hpp"
 #include "mrf/scene/shear_cell.hpp"
 
 namespace mrf {
 
-class DemModel {
+class DemModel final : public Model {
  public:
   DemModel(ShearCell cell, const DemParams& params, IntegratorId scheme, double dt);
 
   // One (accepted) step. For the implicit scheme dt() is the step just taken
   // and the next one is chosen by the error control, at most max_dt().
-  void step();
+  void step() override;
   void set_implicit_options(const ImplicitOptions& o) { implicit_->set_options(o); }
   // The implicit scheme shortens the step that would pass t (s) to end on it.
-  void set_stop_time(double t) { implicit_->set_stop_time(t); }
+  void set_stop_time(double t) override {
+    if (implicit_) implicit_->set_stop_time(t);
+  }
+  bool adaptive() const override { return implicit_.has_value(); }
+  StepSample sample() const override;
+  void finish(RunSummary& s) const override;
   const ImplicitCounters& implicit_counters() const { return implicit_->counters(); }
   double max_dt() const { return implicit_ ? implicit_->max_dt() : dt_; }
 
-  const ShearCell& cell() const { return cell_; }
+  const ShearCell& cell() const override { return cell_; }
   const DemParams& params() const { return p_; }
   const PairSums& sums() const { return sums_; }
-  const DemPairLists& lists() const { return lists_; }
+  const DemPairLists& lists() const override { return lists_; }
   IntegratorId scheme() const { return scheme_; }
-  double dt() const { return implicit_ ? implicit_->dt() : dt_; }
-  double time() const { return time_; }
-  long steps() const { return steps_; }
+  double dt() const override { return implicit_ ? implicit_->dt() : dt_; }
+  double time() const override { return time_; }
+  long steps() const override { return steps_; }
   // Largest overlap the chosen dt keeps stable (m); exceeding it stops the run.
   double overlap_limit() const { return overlap_limit_; }
 
   // Checkpoint: the whole dynamic state (particles, walls, forces, pair
   // lists, clock), so that a restored model continues bit for bit
   // (scene/dem_checkpoint.cpp). load() expects a model built from the same scene.
-  void save(ArchiveWriter& out) const;
-  void load(ArchiveReader& in);
+  void save(ArchiveWriter& out) const override;
+  void load(ArchiveReader& in) override;
 
  private:
   void update_forces();
@@ -68,6 +74,14 @@ class DemModel {
   std::optional<ImplicitStepper> implicit_;
   ImplicitDrift drift_;  // implicit: explicit part of the current step (scratch)
 };
+
+// Verlet lists of a DEM scene: free-free pairs within the dipole cut-off (or
+// contact), free-wall pairs within contact (`walls`), each with the reach of
+// the scheme (the implicit scheme's contact candidates lie within 2R + the
+// contact margin) and its skin; near_reach (m) is that of the implicit
+// scheme's near list of contact candidates.
+DemPairLists dem_pair_lists(const DemParams& p, const Box& box, bool implicit, bool walls, double& near_reach);
+ImplicitContactParams implicit_contact_params(const DemParams& p, const Box& box);
 
 // The DEM part of a checkpoint, shared by DemModel and CoupledModel: free
 // particles (x, v, f), wall positions and the Verlet lists as built (their

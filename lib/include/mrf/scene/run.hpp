@@ -1,28 +1,16 @@
-// One run of a scene: choose the integrator and time step from the stability
-// limits, integrate to the requested strain, write timeseries.csv and
-// summary.json, and return the summary.
+// One run of a scene: the model built by build_model (scene/build_model.hpp)
+// integrated to the requested strain by the one run loop; writes
+// timeseries.csv, summary.json and checkpoints, and returns the summary.
 #pragma once
 #include <map>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
-#include "mrf/integrate/stability.hpp"
+#include <cstdint>
 #include "mrf/io/toml_scene.hpp"
 
 namespace mrf {
-
-struct TimeStepChoice {
-  IntegratorId scheme;
-  double dt;                            // s
-  std::vector<StabilityLimit> limits;   // of the chosen scheme
-  std::vector<StabilityLimit> other;    // of the scheme not chosen (for the printout)
-};
-
-// Automatic choice: the scheme whose smallest limit is largest (auto), and
-// dt = dt_safety * smallest limit; a user dt above the smallest limit is an
-// InputError on numerics.dt naming the binding limit.
-TimeStepChoice choose_time_step(const LoadedScene& scene, const DemParams& p);
 
 struct RunOptions {
   std::string out_dir;  // empty: write nothing

@@ -1,4 +1,4 @@
-#include "mrf/fluid/couette_sph.hpp"
+#include "mrf/scene/fluid_only.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -24,14 +24,14 @@ void validate_scene(const SceneConfig& cfg, double t_end) {
   if (!(t_end > 0) || !std::isfinite(t_end)) {
     std::ostringstream s;
     s << t_end;
-    throw InputError("t_end", s.str(), "", "simulated time must be positive");
+    throw InputError("drive.strain", s.str(), "", "the simulated time strain / shear rate (s) must be positive");
   }
 }
 
 bool use_implicit(const SceneConfig& cfg, const FluidCell& cell) {
   if (cfg.integrator == IntegratorId::implicit) return true;
   if (cfg.integrator != IntegratorId::automatic) return false;
-  return binding_limit(stability_limits(cell, false)).name.starts_with("viscous");
+  return viscous_limit(cell) < smallest(stability_limits(cell, true));
 }
 
 }  // namespace
@@ -53,7 +53,7 @@ CouetteSphResult run_couette_sph(const SceneConfig& cfg, double t_end) {
   CouetteSphResult r;
   r.implicit_viscosity = use_implicit(cfg, cell);
   r.limits = stability_limits(cell, r.implicit_viscosity);
-  double dt = cfg.dt_safety * binding_limit(r.limits).dt;
+  double dt = cfg.dt_safety * smallest(r.limits);
   if (cfg.dt) {
     check_time_step(cell, *cfg.dt, r.implicit_viscosity);
     dt = *cfg.dt;

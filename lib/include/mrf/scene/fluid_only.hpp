@@ -28,7 +28,7 @@ struct CouetteSphResult {
   bool implicit_viscosity = false;
   double dt = 0;                     // s
   std::int64_t steps = 0;
-  std::vector<SphStepLimit> limits;  // of the scheme used, at start
+  std::vector<StabilityLimit> limits;  // of the scheme used, at start
   double wall_seconds = 0;
   std::size_t n_fluid = 0, n_wall = 0;
 };

@@ -1,0 +1,24 @@
+// The coupled part of a particle mobility, for the implicit contact step: a
+// symmetric positive semi-definite operator C (1/kg) through which a force
+// on one particle moves others (the fluid they share,
+// coupling/fluid_response.hpp). The diagonal part stays a per-particle array.
+#pragma once
+#include <cstddef>
+#include <vector>
+
+#include "mrf/vec.hpp"
+
+namespace mrf {
+
+class MobilityCoupling {
+ public:
+  // y_i += scale sum_j C_ij f_j.
+  virtual void add(const std::vector<Vec3>& f, double scale, std::vector<Vec3>& y) = 0;
+  virtual double diagonal(std::size_t i) const = 0;                 // C_ii
+  virtual double coupling(std::size_t i, std::size_t k) const = 0;  // C_ik
+
+ protected:
+  ~MobilityCoupling() = default;
+};
+
+}  // namespace mrf

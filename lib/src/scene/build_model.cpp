@@ -1,0 +1,240 @@
+#include "mrf/scene/build_model.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "mrf/error.hpp"
+#include "mrf/fluid/fluid_observables.hpp"
+#include "mrf/fluid/wcsph.hpp"
+#include "mrf/forces/drag.hpp"
+#include "mrf/observe/stress.hpp"
+#include "mrf/scene/dem_model.hpp"
+#include "mrf/scene/fluid_only.hpp"
+#include "mrf/scene/run_series.hpp"
+
+namespace mrf {
+
+namespace {
+
+// Porosity the explicit viscous limit is designed for: the initial minimum,
+// but no more than 0.5 (chains lower eps locally during a run; at phi = 0.3
+// and a kernel of >= 2d the SPH-scale porosity stays above it).
+constexpr double k_design_porosity = 0.5;
+// Verlet skin of the SPH pairs of the inertialess coupled scheme, / h: an SPH
+// particle moves ~1e-7 of h per sub-step, so the list lasts tens of sub-steps.
+constexpr double k_sph_skin_over_h = 0.2;
+
+std::string g3(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3g", v);
+  return b;
+}
+
+void refuse_dt_above(const LoadedScene& scene, double dt, const StabilityLimit& b, const std::string& what) {
+  char value[32];
+  std::snprintf(value, sizeof value, "%.6g s", dt);
+  throw InputError("numerics.dt", value, scene.locate("numerics.dt"),
+                   "above the stability limit " + g3(b.dt) + " s of the " + what + ", set by '" + b.name + "' (" +
+                       b.basis + ")");
+}
+
+void print_table(const char* label, const std::vector<StabilityLimit>& limits) {
+  for (const auto& x : limits)
+    std::fprintf(stderr, "  %-13s %-22s dt < %-10.3g  %s\n", label, x.name.c_str(), x.dt, x.basis.c_str());
+}
+
+}  // namespace
+
+TimeStepChoice choose_time_step(const LoadedScene& scene, const DemParams& p) {
+  const SceneConfig& c = scene.config;
+  auto ve = dem_limits(p, c.gap, IntegratorId::verlet_exp);
+  auto od = dem_limits(p, c.gap, IntegratorId::overdamped);
+  auto im = dem_limits(p, c.gap, IntegratorId::implicit);
+  TimeStepChoice t{};
+  t.scheme = c.integrator == IntegratorId::automatic ? auto_integrator(ve, od, im, stokes_number(p)) : c.integrator;
+  switch (t.scheme) {
+    case IntegratorId::verlet_exp: t.limits = ve, t.other = od; break;
+    case IntegratorId::overdamped: t.limits = od, t.other = ve; break;
+    default: t.limits = im, t.other = smallest(ve) >= smallest(od) ? ve : od; break;
+  }
+  const StabilityLimit& b = binding(t.limits);
+  if (c.dt) {
+    if (*c.dt > b.dt) refuse_dt_above(scene, *c.dt, b, std::string(to_string(t.scheme)) + " integrator");
+    t.dt = *c.dt;
+  } else {
+    // implicit: the bound is the largest step of an error-controlled scheme, not a stability limit
+    t.dt = t.scheme == IntegratorId::implicit ? b.dt : c.dt_safety * b.dt;
+  }
+  return t;
+}
+
+CoupledDrag coupled_drag(ModelId m) {
+  return m == ModelId::demsph_dd ? CoupledDrag::di_felice : CoupledDrag::stokes;
+}
+
+CoupledTimeStep choose_coupled_time_step(const LoadedScene& scene, const DemParams& p, const FluidCell& fluid,
+                                         double eps_min) {
+  const SceneConfig& c = scene.config;
+  if (c.integrator == IntegratorId::overdamped)
+    throw InputError("numerics.integrator", to_string(c.integrator), scene.locate("numerics.integrator"),
+                     "the coupled models integrate the particles with inertia ('verlet_exp') or inertialess with "
+                     "implicit contacts ('implicit'), or choose by the Stokes number ('auto')");
+  const bool inertialess = c.integrator == IntegratorId::implicit ||
+                           (c.integrator == IntegratorId::automatic && stokes_number(p) <= k_inertialess_max_stokes);
+  CoupledTimeStep t;
+  CoupledStepping& s = t.stepping;
+  s.scheme = inertialess ? CoupledScheme::inertialess : CoupledScheme::inertial;
+  // The SPH step: CFL (and force), and the viscous bound of the averaged
+  // equations, 0.125 h^2 eps rho_f / eta (the superficial density carries
+  // the momentum), unless the viscosity is implicit.
+  t.fluid_limits = stability_limits(fluid, true);
+  const double viscous = coupled_viscous_limit(fluid, eps_min);
+  s.implicit_viscosity = inertialess && k_implicit_viscosity_gain * viscous < smallest(t.fluid_limits);
+  if (!s.implicit_viscosity)
+    t.fluid_limits.push_back({"viscous (averaged)", viscous,
+                              "0.125 h^2 eps rho_f / eta, eps = " + g3(eps_min) + " (superficial density)"});
+  const StabilityLimit& bf = binding(t.fluid_limits);
+  if (inertialess) {
+    t.dem_limits = dem_limits(p, c.gap, IntegratorId::implicit);
+    const StabilityLimit& bd = binding(t.dem_limits);
+    if (c.dt && *c.dt > bd.dt) refuse_dt_above(scene, *c.dt, bd, "implicit coupled step");
+    s.dt_max = c.dt ? *c.dt : bd.dt;
+    s.dt_fluid = c.dt_safety * bf.dt;
+    s.sph_skin = k_sph_skin_over_h * fluid.h;
+    s.implicit.tol_over_radius = c.implicit_tol;
+    s.implicit.order = c.implicit_order;
+    return t;
+  }
+  t.dem_limits = dem_limits(p, c.gap, IntegratorId::verlet_exp);
+  if (c.dt && *c.dt > bf.dt) refuse_dt_above(scene, *c.dt, bf, "SPH step of the coupled models");
+  s.dt_fluid = c.dt ? *c.dt : c.dt_safety * bf.dt;
+  const double dem_dt = c.dt_safety * smallest(t.dem_limits);
+  s.substeps = std::max(1, static_cast<int>(std::ceil(s.dt_fluid / dem_dt - 1e-9)));
+  return t;
+}
+
+namespace {
+
+BuiltModel build_dem(const LoadedScene& scene, ShearCell cell, const DemParams& p, bool quiet) {
+  const SceneConfig& c = scene.config;
+  const TimeStepChoice ts = choose_time_step(scene, p);
+  BuiltModel b;
+  RunSummary& s = b.summary;
+  s = scene_summary(c);
+  s.integrator = to_string(ts.scheme);
+  s.binding_limit = binding(ts.limits).name;
+  s.dt = ts.dt;
+  b.planned_steps = static_cast<long>(std::ceil(c.strain / (c.shear_rate * ts.dt)));
+  s.steps = b.planned_steps;
+  s.n_particles = static_cast<long>(cell.free.size());
+  s.n_wall = static_cast<long>(cell.walls.size());
+  s.stokes_number = stokes_number(p);
+  s.reynolds_number = particle_reynolds(c);
+  s.stress_fluid = imposed_fluid_stress(c.viscosity, c.shear_rate);
+  if (!quiet) {
+    std::fprintf(stderr, "mrf: %s, Mn = %.4g (9 eta gdot / 2 mu0 M^2), gdot = %.4g 1/s\n", s.model.c_str(), s.mason,
+                 s.shear_rate);
+    for (IntegratorId id : {IntegratorId::verlet_exp, IntegratorId::overdamped, IntegratorId::implicit}) {
+      const auto l = dem_limits(p, c.gap, id);
+      print_table(to_string(id), l);
+      std::fprintf(stderr, "  %-13s bound by '%s' (dt < %.3g s)\n", to_string(id), binding(l).name.c_str(),
+                   smallest(l));
+    }
+    std::fprintf(stderr, "  chosen: %s, %s dt %s %.4g s (bound by '%s'); St = %.3g (inertialess up to %.3g), "
+                 "Re_p = %.3g\n",
+                 s.integrator.c_str(), ts.scheme == IntegratorId::implicit ? "error-controlled" : "fixed",
+                 ts.scheme == IntegratorId::implicit ? "<=" : "=", ts.dt, s.binding_limit.c_str(), s.stokes_number,
+                 k_inertialess_max_stokes, s.reynolds_number);
+  }
+  auto model = std::make_unique<DemModel>(std::move(cell), p, ts.scheme, ts.dt);
+  ImplicitOptions o;
+  o.tol_over_radius = c.implicit_tol;
+  o.order = c.implicit_order;
+  if (ts.scheme == IntegratorId::implicit) model->set_implicit_options(o);
+  b.model = std::move(model);
+  return b;
+}
+
+BuiltModel build_coupled(const LoadedScene& scene, ShearCell cell, const DemParams& p, bool quiet) {
+  const SceneConfig& c = scene.config;
+  FluidCell fluid = [&] {
+    try {
+      return build_coupled_fluid(c, cell);
+    } catch (const InputError& e) {  // FluidParams::validate names the key; the scene knows its line
+      throw e.at(scene.locate(e.key()));
+    }
+  }();
+  const auto pairs0 = coupling_pairs(cell.free.x, fluid.fluid.x, cell.box, fluid.h);
+  const auto eps0 = porosity_at_fluid(fluid.fluid.size(), sphere_volume(c.radius), pairs0).eps;
+  const double eps_design = std::min(k_design_porosity, *std::min_element(eps0.begin(), eps0.end()));
+  const CoupledTimeStep ts = choose_coupled_time_step(scene, p, fluid, eps_design);
+  const CoupledStepping& st = ts.stepping;
+  const bool inertialess = st.scheme == CoupledScheme::inertialess;
+  BuiltModel b;
+  RunSummary& s = b.summary;
+  s = scene_summary(c);
+  const double dt_dem = inertialess ? st.dt_max : st.dt_fluid / st.substeps;
+  s.integrator = inertialess ? (st.implicit_viscosity ? "inertialess_implicit+sph_implicit_viscosity"
+                                                       : "inertialess_implicit+sph_explicit")
+                             : "sph_explicit+dem_verlet_exp_parcel";
+  s.binding_limit = inertialess ? binding(ts.dem_limits).name : binding(ts.fluid_limits).name;
+  s.dt = dt_dem;
+  b.planned_steps = static_cast<long>(std::ceil(c.strain / (c.shear_rate * (inertialess ? st.dt_max : st.dt_fluid))));
+  s.steps = inertialess ? b.planned_steps : b.planned_steps * st.substeps;
+  s.n_particles = static_cast<long>(cell.free.size());
+  s.n_wall = static_cast<long>(cell.walls.size());
+  s.n_fluid = static_cast<long>(fluid.fluid.size());
+  s.stokes_number = stokes_number(p);
+  s.reynolds_number = particle_reynolds(c);
+  s.extra = {{"dt_fluid", st.dt_fluid},
+             {"tau_p", p.tau_p},
+             {"dt_fluid_over_tau_p", st.dt_fluid / p.tau_p},
+             {"sph_spacing", fluid.params.spacing},
+             {"sph_h", fluid.h},
+             {"sound_speed", fluid.c0},
+             {"n_fluid_wall", static_cast<double>(fluid.wall.size())},
+             {"cell_reynolds", reynolds_number(fluid.params, fluid.box)},
+             {"porosity_design", eps_design}};
+  if (!inertialess) s.extra["substeps"] = st.substeps;
+  if (!quiet) {
+    std::fprintf(stderr, "mrf: %s, Mn = %.4g (9 eta gdot / 2 mu0 M^2), gdot = %.4g 1/s\n", s.model.c_str(), s.mason,
+                 s.shear_rate);
+    std::fprintf(stderr, "  SPH: %zu fluid + %zu wall particles, dx = %.3g m, h = %.3g m, c0 = %.3g m/s\n",
+                 fluid.fluid.size(), fluid.wall.size(), fluid.params.spacing, fluid.h, fluid.c0);
+    print_table("fluid", ts.fluid_limits);
+    print_table(inertialess ? "particles" : "DEM sub-step", ts.dem_limits);
+    if (inertialess)
+      std::fprintf(stderr,
+                   "  chosen: inertialess particles (St = %.3g <= %.3g), implicit contacts, error-controlled dt <= "
+                   "%.4g s (bound by '%s'); SPH sub-steps <= %.4g s, viscosity %s; Re_p = %.3g\n",
+                   s.stokes_number, k_inertialess_max_stokes, st.dt_max, s.binding_limit.c_str(), st.dt_fluid,
+                   st.implicit_viscosity ? "implicit" : "explicit", s.reynolds_number);
+    else
+      std::fprintf(stderr,
+                   "  chosen: inertial particles (St = %.3g), fluid dt = %.4g s (%.3g tau_p) with %d DEM sub-steps "
+                   "of %.4g s; Re_p = %.3g\n",
+                   s.stokes_number, st.dt_fluid, st.dt_fluid / p.tau_p, st.substeps, dt_dem, s.reynolds_number);
+  }
+  b.model = std::make_unique<CoupledModel>(std::move(cell), p, std::move(fluid), coupled_drag(c.model), st);
+  return b;
+}
+
+}  // namespace
+
+BuiltModel build_model(const LoadedScene& scene, bool quiet) {
+  const SceneConfig& c = scene.config;
+  if (c.threads > 0) omp_set_num_threads(c.threads);
+  const DemParams p = dem_params(c);
+  ShearCell cell = build_shear_cell(c, scene.locate("particles.volume_fraction"));
+  for (std::size_t i = 0; i < cell.free.size(); ++i) cell.free.v[i] = couette_velocity(cell.free.x[i], c.shear_rate);
+  BuiltModel b = c.model == ModelId::dem_stokes ? build_dem(scene, std::move(cell), p, quiet)
+                                                : build_coupled(scene, std::move(cell), p, quiet);
+  b.summary.extra.insert({{"dipole_cutoff", c.dipole_cutoff}, {"gap", c.gap}, {"box_ly", c.ly}, {"box_lz", c.lz}});
+  return b;
+}
+
+}  // namespace mrf
