@@ -30,14 +30,38 @@ inline Vec3 dipole_force(const Vec3& r_ik, const Vec3& m_i, const Vec3& m_k) {
 // F = (3 mu0 m^2 / 4 pi r^4) [(1 - 5c^2) r^ + 2c x^]. `pref` = 3 mu0 m^2 / (4 pi).
 inline double dipole_prefactor(double moment) { return 3.0 * k_mu0 * moment * moment / (4.0 * k_pi); }
 
+// Pair evaluator of this law in the HOOMD style (STYLE.md §1), the one place
+// it is written: the loop supplies r_ik = (dx, dy, dz) (m) and the 1/r it
+// has already computed, and keeps the cut-off, +-F, virial and sums. The energy
+// U = (mu0 m^2 / 4 pi r^3)(1 - 3c^2) = (pref/3)(1 - 3c^2)/r^3 comes back
+// without its constant factor, so a loop sums (1 - 3c^2)/r^3 and scales once.
+struct DipoleX {
+  double pref;  // 3 mu0 m^2 / (4 pi) (N m^4)
+
+  // Sets f to the force on i (N); returns (1 - 3c^2)/r^3 (1/m^3).
+  double eval(double dx, double dy, double dz, double inv_r, Vec3& f) const {
+    const double inv_r2 = inv_r * inv_r;
+    const double c = dx * inv_r, c2 = c * c;
+    const double s = pref * inv_r2 * inv_r2;       // pref / r^4
+    const double a = s * (1.0 - 5.0 * c2) * inv_r;  // radial part / r
+    f = Vec3(a * dx + 2.0 * s * c, a * dy, a * dz);
+    return (1.0 - 3.0 * c2) * inv_r2 * inv_r;
+  }
+  // J m^3: turns a sum of eval() returns into an energy.
+  double energy_scale() const { return pref / 3.0; }
+};
+
 inline Vec3 dipole_force_x(const Vec3& r_ik, double pref) {
-  const double r2 = r_ik.squaredNorm();
-  const double inv_r = 1.0 / std::sqrt(r2);
-  const double c = r_ik.x() * inv_r;
-  const double s = pref / (r2 * r2);
-  Vec3 f = (s * (1.0 - 5.0 * c * c) * inv_r) * r_ik;
-  f.x() += 2.0 * s * c;
+  Vec3 f;
+  DipoleX{pref}.eval(r_ik.x(), r_ik.y(), r_ik.z(), 1.0 / r_ik.norm(), f);
   return f;
+}
+
+// Energy (J) of the equal-moment pair: the same evaluator, scaled.
+inline double dipole_energy_x(const Vec3& r_ik, double pref) {
+  const DipoleX law{pref};
+  Vec3 f;
+  return law.energy_scale() * law.eval(r_ik.x(), r_ik.y(), r_ik.z(), 1.0 / r_ik.norm(), f);
 }
 
 // Head-to-tail force magnitude at contact (r = 2R): (pi/6) mu0 R^2 M^2 (N).
