@@ -52,14 +52,6 @@ void StressSeries::push(const SeriesRow& r) {
 
 Measurement StressSeries::fluid() const { return measure(fluid_); }
 
-void StressSeries::save(ArchiveWriter& a) const {
-  for (const auto* v : {&total_, &particles_, &fluid_, &virial_, &mag_, &con_, &diff_, &vir_fluid_, &vir_total_}) a.put(*v);
-}
-
-void StressSeries::load(ArchiveReader& a) {
-  for (auto* v : {&total_, &particles_, &fluid_, &virial_, &mag_, &con_, &diff_, &vir_fluid_, &vir_total_}) a.get(*v);
-}
-
 void StressSeries::finish(RunSummary& s) const {
   s.stress_total = measure(total_);
   s.stress_particles = measure(particles_);
@@ -127,30 +119,6 @@ long series_every(const LoadedScene& scene, long steps) {
   return every;
 }
 
-void LoopState::save(ArchiveWriter& a) const {
-  a.put(n);
-  a.put(row_start);
-  a.put(strain_before);
-  se.save(a);
-  a.put(max_overlap);
-  a.put(pair_evals);
-  a.put(elapsed_before);
-  a.put(ts_bytes);
-  a.put(frames_bytes);
-}
-
-void LoopState::load(ArchiveReader& a) {
-  a.get(n);
-  a.get(row_start);
-  a.get(strain_before);
-  se.load(a);
-  a.get(max_overlap);
-  a.get(pair_evals);
-  a.get(elapsed_before);
-  a.get(ts_bytes);
-  a.get(frames_bytes);
-}
-
 std::string scene_fingerprint(const SceneConfig& c) {
   std::string out;
   char buf[64];
@@ -183,6 +151,7 @@ bool RunFiles::open(LoopState& st, bool with_frames, const LoadModel& load_model
                        "another --out");
     st.load(in);
     load_model(in);
+    in.expect_end();
     resumed = true;
   }
   if (!opt_.out_dir.empty()) {
@@ -223,12 +192,11 @@ void RunFiles::end_row(const LoopState& st, long n, double strain, bool more, co
       frames.flush();
       snap.frames_bytes = static_cast<std::uint64_t>(std::filesystem::file_size(opt_.out_dir + "/frames.xyz"));
     }
-    ArchiveWriter out(checkpoint_ + ".tmp");
+    ArchiveWriter out(checkpoint_);
     out.put(fingerprint_);
     snap.save(out);
     save_model(out);
-    out.close();
-    std::filesystem::rename(checkpoint_ + ".tmp", checkpoint_);
+    out.close();  // atomic: a kill while writing leaves the previous checkpoint
     last_checkpoint_ = now;
     rows_since_checkpoint_ = 0;
   }

@@ -42,8 +42,14 @@ class StressSeries {
   void finish(RunSummary& s) const;
   std::size_t size() const { return total_.size(); }
   Measurement fluid() const;
-  void save(ArchiveWriter& a) const;  // checkpoints
-  void load(ArchiveReader& a);
+  // Checkpoints: one field list for both directions, Self = StressSeries or
+  // const StressSeries (Archive::io puts or gets each field).
+  template <class Archive, class Self>
+  static void serialize(Archive& ar, Self& s) {
+    ar.io(s.total_, s.particles_, s.fluid_, s.virial_, s.mag_, s.con_, s.diff_, s.vir_fluid_, s.vir_total_);
+  }
+  void save(ArchiveWriter& a) const { serialize(a, *this); }
+  void load(ArchiveReader& a) { serialize(a, *this); }
 
  private:
   std::vector<double> total_, particles_, fluid_, virial_, mag_, con_, diff_, vir_fluid_, vir_total_;
@@ -73,8 +79,13 @@ struct LoopState {
   long pair_evals = 0;
   double elapsed_before = 0;  // wall seconds of earlier sessions of this run
   std::uint64_t ts_bytes = 0, frames_bytes = 0;  // lengths of timeseries.csv and frames.xyz
-  void save(ArchiveWriter& a) const;
-  void load(ArchiveReader& a);
+  template <class Archive, class Self>  // as StressSeries::serialize
+  static void serialize(Archive& ar, Self& s) {
+    ar.io(s.n, s.row_start, s.strain_before, s.se, s.max_overlap, s.pair_evals, s.elapsed_before, s.ts_bytes,
+          s.frames_bytes);
+  }
+  void save(ArchiveWriter& a) const { serialize(a, *this); }
+  void load(ArchiveReader& a) { serialize(a, *this); }
 };
 
 // Every parameter of the scene, exactly: a checkpoint resumes only into the same run.
@@ -82,18 +93,22 @@ std::string scene_fingerprint(const SceneConfig& c);
 
 // The files of a run loop in RunOptions::out_dir (none when it is empty):
 // timeseries.csv, frames.xyz, checkpoint.bin and summary.json. A checkpoint
-// holds the scene fingerprint, the LoopState and what the loop saves of its
-// model; it is written atomically (temporary file + rename) at a row
-// boundary every checkpoint_seconds of wall time (or checkpoint_every_rows
-// rows) and removed when the run completes.
+// (an archive, io/archive.hpp: header, payload, checksum) holds the scene
+// fingerprint, the LoopState and what the loop saves of its model; it is
+// written atomically (temporary file + rename) at a row boundary every
+// checkpoint_seconds of wall time (or checkpoint_every_rows rows) and removed
+// when the run completes.
 class RunFiles {
  public:
   using SaveModel = std::function<void(ArchiveWriter&)>;
   using LoadModel = std::function<void(ArchiveReader&)>;
   RunFiles(const RunOptions& opt, const SceneConfig& c);
-  // With RunOptions::resume and a checkpoint in out_dir: checks its
-  // fingerprint (InputError on "--resume" if another scene wrote it), loads
-  // `st`, then the model with `load_model`. Opens timeseries.csv and, with
+  // With RunOptions::resume and a checkpoint in out_dir: verifies the archive
+  // (NumericalError if it is foreign, of another version, truncated or
+  // corrupt), checks its fingerprint (InputError on "--resume" if another
+  // scene wrote it), loads `st`, then the model with `load_model`, which must
+  // read the payload to its end. Nothing in out_dir changes before all of
+  // this has succeeded. Opens timeseries.csv and, with
   // `with_frames`, frames.xyz: new, or cut back to the checkpoint and
   // appended to. Returns whether the run resumed.
   bool open(LoopState& st, bool with_frames, const LoadModel& load_model);
