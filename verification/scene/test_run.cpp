@@ -355,6 +355,18 @@ TEST(RunOutput, SummaryJsonHasEveryKeyOfTheDesign) {
   EXPECT_DOUBLE_EQ(j["reynolds_number"].get<double>(), 1000 * s.shear_rate * 2.5e-6 * 2.5e-6 / k_eta);
 }
 
+// The carrier fluid's viscosity and density are in summary.json (mrf
+// criterion reads the viscosity from there, through sweep.csv).
+TEST(RunOutput, SummaryJsonHasTheFluidViscosityAndDensity) {
+  const RunResult& r = base_run();
+  const nlohmann::json j = nlohmann::json::parse(r.json);
+  ASSERT_TRUE(j.contains("viscosity") && j["viscosity"].is_number()) << r.json;
+  ASSERT_TRUE(j.contains("fluid_density") && j["fluid_density"].is_number()) << r.json;
+  EXPECT_EQ(j["viscosity"].get<double>(), r.scene.config.viscosity);
+  EXPECT_EQ(j["viscosity"].get<double>(), k_eta);
+  EXPECT_EQ(j["fluid_density"].get<double>(), 1000.0);
+}
+
 TEST(RunOutput, TimeseriesHasOneRowPerOutputInterval) {
   const RunResult& r = base_run();
   const RunSummary& s = r.summary;

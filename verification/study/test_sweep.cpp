@@ -12,6 +12,9 @@
 #include <sstream>
 
 #include "mrf/error.hpp"
+#include "mrf/io/toml_scene.hpp"
+#include "mrf/scene/run_series.hpp"
+#include "mrf/study/criterion.hpp"
 
 namespace mrf {
 namespace {
@@ -144,6 +147,29 @@ TEST(Sweep, KilledSweepResumesAndReproduces) {
 
 namespace mrf {
 namespace {
+
+// summary.json -> sweep.csv -> the criterion's table: the carrier viscosity
+// and density travel with every point, so a sweep of the SPH models alone
+// has them (the criterion used to rebuild eta from a model-1 row).
+TEST(Sweep, SweepCsvCarriesTheFluidViscosityAndDensity) {
+  const auto out = std::filesystem::temp_directory_path() / "mrf_test_sweep_fluid";
+  std::filesystem::remove_all(out);
+  const SweepSpec s = parse_sweep(
+      "[sweep]\nscene = \"small_dem_stokes.toml\"\nmodels = [\"demsph_dd\"]\nmason = [0.1]\nseeds = [1]\n"
+      "set = [\"fluid.viscosity=0.25\", \"fluid.density=960\"]\n",
+      "fluid.toml", k_scenes);
+  const auto pts = sweep_points(s);
+  ASSERT_EQ(pts.size(), 1u);
+  const LoadedScene scene = load_scene(s.scene_path, pts[0].sets);
+  std::filesystem::create_directories(out / pts[0].dir);
+  std::ofstream(out / pts[0].dir / "summary.json") << summary_json(scene_summary(scene.config));
+  const std::string csv = sweep_csv(pts, out.string());
+  std::ofstream(out / "sweep.csv") << csv;
+  const SweepTable t = read_sweep_csv((out / "sweep.csv").string());
+  EXPECT_EQ(t.viscosity, 0.25) << csv;
+  EXPECT_EQ(t.fluid_density, 960) << csv;
+  EXPECT_TRUE(t.viscosity_note.empty()) << t.viscosity_note;
+}
 
 TEST(Sweep, FailedPointCountsAsFinishedUntilItsFolderIsDeleted) {
   const auto d = std::filesystem::temp_directory_path() / "mrf_test_point";

@@ -43,6 +43,8 @@ std::string summary_json(const RunSummary& s) {
   j["particle_density"] = s.density;
   j["magnetization"] = s.magnetization;
   j["volume_fraction"] = s.volume_fraction;
+  j["viscosity"] = s.viscosity;          // Pa s, the carrier fluid's (mrf criterion reads it)
+  j["fluid_density"] = s.fluid_density;  // kg/m^3
   j["seed"] = s.seed;
   for (const auto& [key, value] : s.extra) j[key] = value;
   j["version"] = MRF_VERSION;

@@ -89,6 +89,8 @@ RunSummary scene_summary(const SceneConfig& c) {
   s.density = c.density;
   s.magnetization = c.magnetization;
   s.volume_fraction = c.volume_fraction;
+  s.viscosity = c.viscosity;
+  s.fluid_density = c.fluid_density;
   s.seed = c.seed;
   s.threads = omp_get_max_threads();
   return s;

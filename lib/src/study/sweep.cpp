@@ -206,7 +206,7 @@ std::string sweep_csv(const std::vector<SweepPoint>& points, const std::string& 
                                   "stress_virial_magnetic",
                                   "stress_virial_contact", "n_particles", "n_fluid", "dt", "steps", "wall_seconds",
                                   "stokes_number", "reynolds_number", "max_overlap_over_radius", "volume_fraction",
-                                  "magnetization", "youngs_modulus"};
+                                  "magnetization", "youngs_modulus", "viscosity", "fluid_density"};
   std::ostringstream csv;
   csv.precision(10);
   csv << "model,mason,seed,status";

@@ -50,7 +50,7 @@ class StressSeries {
 };
 
 // The fields of summary.json that come from the scene alone (model, Mn,
-// shear rate, strains, material, seed) and the thread count.
+// shear rate, strains, material, carrier fluid, seed) and the thread count.
 RunSummary scene_summary(const SceneConfig& c);
 
 void write_series_header(std::ostream& out);
