@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -169,6 +171,41 @@ TEST(Sweep, SweepCsvCarriesTheFluidViscosityAndDensity) {
   EXPECT_EQ(t.viscosity, 0.25) << csv;
   EXPECT_EQ(t.fluid_density, 960) << csv;
   EXPECT_TRUE(t.viscosity_note.empty()) << t.viscosity_note;
+}
+
+// A Mason number with more digits than the folder label: the point's scene,
+// its summary.json and sweep.csv all hold the sweep file's value bit for bit
+// (the override used to be the 4-digit label, 0.01235 for 0.0123456789).
+TEST(Sweep, PointSceneAndSweepCsvHoldTheExactMasonNumber) {
+  const auto out = std::filesystem::temp_directory_path() / "mrf_test_sweep_mason";
+  std::filesystem::remove_all(out);
+  const SweepSpec s = parse_sweep(
+      "[sweep]\nscene = \"small_dem_stokes.toml\"\nmodels = [\"dem_stokes\"]\n"
+      "mason = [0.0123456789, 0.1, 3.3333333333333335e-5]\nseeds = [1]\n",
+      "mason.toml", k_scenes);
+  const auto pts = sweep_points(s);
+  ASSERT_EQ(pts.size(), 3u);
+  EXPECT_EQ(pts[0].mason, 0.0123456789);
+  EXPECT_EQ(pts[0].dir, "dem_stokes/mn_0.01235_seed_1");  // folder names keep 4 digits
+  for (const auto& p : pts) {
+    const LoadedScene scene = load_scene(s.scene_path, p.sets);
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(scene.config.mason), std::bit_cast<std::uint64_t>(p.mason))
+        << p.dir << ": " << scene.config.mason << " != " << p.mason;
+    std::filesystem::create_directories(out / p.dir);
+    std::ofstream(out / p.dir / "summary.json") << summary_json(scene_summary(scene.config));
+  }
+  std::istringstream csv(sweep_csv(pts, out.string()));
+  std::string line;
+  std::getline(csv, line);
+  for (const auto& p : pts) {
+    ASSERT_TRUE(std::getline(csv, line));
+    const std::string cell = line.substr(line.find(',') + 1, line.find(',', line.find(',') + 1) - line.find(',') - 1);
+    const double in_csv = std::strtod(cell.c_str(), nullptr);
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(in_csv), std::bit_cast<std::uint64_t>(p.mason)) << line;
+    std::ifstream in(out / p.dir / "summary.json");
+    const double in_summary = nlohmann::json::parse(in)["mason"].get<double>();
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(in_summary), std::bit_cast<std::uint64_t>(in_csv)) << line;
+  }
 }
 
 TEST(Sweep, FailedPointCountsAsFinishedUntilItsFolderIsDeleted) {
