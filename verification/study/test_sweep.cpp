@@ -208,6 +208,31 @@ TEST(Sweep, PointSceneAndSweepCsvHoldTheExactMasonNumber) {
   }
 }
 
+// An SPH spacing that does not divide the gap (80 um / 6 um) is refused for
+// the demsph_dd point before any point runs (it used to fail only when the
+// sweep reached it, after the dem_stokes point had run), naming the point,
+// the key, where it was set and the value.
+TEST(Sweep, CoupledPointWithABadSphSpacingStopsTheSweepBeforeAnyRun) {
+  const auto out = std::filesystem::temp_directory_path() / "mrf_test_sweep_sph";
+  std::filesystem::remove_all(out);
+  const SweepSpec s = parse_sweep(
+      "[sweep]\nscene = \"small_dem_stokes.toml\"\nmodels = [\"dem_stokes\", \"demsph_dd\"]\nmason = [0.1]\n"
+      "seeds = [1]\nset = [\"drive.strain=0.5\", \"drive.warmup_strain=0.1\", \"fluid.sph_spacing=6e-6\"]\n",
+      "sph.toml", k_scenes);
+  SweepOptions opt;
+  opt.quiet = true;
+  try {
+    run_sweep(s, out.string(), opt);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(e.key(), "fluid.sph_spacing") << msg;
+    for (const char* part : {"demsph_dd/mn_0.1_seed_1", "--set fluid.sph_spacing=6e-6", "6e-06", "box.gap"})
+      EXPECT_NE(msg.find(part), std::string::npos) << part << " not in: " << msg;
+  }
+  EXPECT_FALSE(std::filesystem::exists(out / "dem_stokes")) << "a point ran before the check";
+}
+
 TEST(Sweep, FailedPointCountsAsFinishedUntilItsFolderIsDeleted) {
   const auto d = std::filesystem::temp_directory_path() / "mrf_test_point";
   std::filesystem::remove_all(d);
