@@ -92,6 +92,11 @@ int criterion_command(const std::string& path, const std::string& thresholds_pat
   out["mason_convention"] = "Mn = 9 eta gdot / (2 mu0 M^2)";
   out["magnetization"] = table.magnetization;
   out["viscosity"] = table.viscosity;
+  out["fluid_density"] = table.fluid_density;
+  if (!table.viscosity_note.empty()) {
+    out["viscosity_note"] = table.viscosity_note;
+    std::fprintf(stderr, "mrf criterion: note: %s\n", table.viscosity_note.c_str());
+  }
   out["volume_fraction"] = table.volume_fraction;
   std::map<std::string, std::vector<mrf::FlowPoint>> curves;
   for (const auto& [model, samples] : table.samples) {

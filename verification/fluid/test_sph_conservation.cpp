@@ -3,9 +3,14 @@
 // disturbed start, NaN detection, parameter validation and dt refusal.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "mrf/error.hpp"
+#include "mrf/io/toml_scene.hpp"
 #include "sph_channel.hpp"
 
 namespace mrf::test {
@@ -98,6 +103,58 @@ TEST(SphParams, ValidationNamesTheKey) {
   q = p;
   q.shear_rate = 0;
   EXPECT_THROW(build_fluid_cell(box, q), InputError);  // no scale for c0
+}
+
+// Every key the validation names is one a scene can set (the scene parser
+// knows it), or the message says it is an internal parameter: no error sends
+// the user looking for a key such as fluid.h_over_dx that does not exist.
+TEST(SphParams, ValidationNamesOnlyKeysAUserCanSet) {
+  FluidParams p;
+  p.viscosity = 0.1;
+  p.density = 1000;
+  p.spacing = 10e-6;
+  p.shear_rate = 100;
+  const Box box{150e-6, 50e-6, 120e-6};
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<std::pair<FluidParams, Box>> cases;
+  auto with = [&](auto field, double v) {
+    FluidParams q = p;
+    q.*field = v;
+    cases.push_back({q, box});
+  };
+  with(&FluidParams::viscosity, -1);
+  with(&FluidParams::density, 0);
+  with(&FluidParams::spacing, 0);
+  with(&FluidParams::h_over_dx, 3);
+  with(&FluidParams::sound_speed, -1);
+  with(&FluidParams::shear_rate, inf);
+  with(&FluidParams::body_force, inf);
+  with(&FluidParams::density_tolerance, 0.5);
+  with(&FluidParams::cg_tolerance, 0.1);
+  cases.push_back({p, Box{0, 50e-6, 120e-6}});
+  cases.push_back({p, Box{155e-6, 50e-6, 120e-6}});
+  cases.push_back({p, Box{150e-6, 20e-6, 120e-6}});
+  const std::string scene = MRF_SOURCE_DIR "/experiments/scenes/couette_sph.toml";
+  for (const auto& [q, b] : cases) {
+    std::string key, msg;
+    try {
+      q.validate(b);
+      ADD_FAILURE() << "no InputError";
+      continue;
+    } catch (const InputError& e) {
+      key = e.key();
+      msg = e.what();
+    }
+    std::string as_override;  // what the scene parser says about the key
+    try {
+      load_scene(scene, {key + "=1"});
+    } catch (const InputError& e) {
+      as_override = e.what();
+    }
+    const bool scene_key = as_override.find("unknown key") == std::string::npos;
+    EXPECT_TRUE(scene_key || msg.find("not a scene key") != std::string::npos)
+        << "'" << key << "' is no scene key (" << as_override << ") and the message does not say so: " << msg;
+  }
 }
 
 TEST(SphParams, AutomaticSoundSpeedFollowsMorris) {

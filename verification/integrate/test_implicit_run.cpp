@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "mrf/error.hpp"
 #include "mrf/forces/hertz.hpp"
 #include "mrf/io/toml_scene.hpp"
 #include "mrf/scene/build_model.hpp"
@@ -71,6 +72,40 @@ TEST(ImplicitRun, ShortRunReportsCountsAndBoundedSteps) {
   EXPECT_TRUE(std::isfinite(r.stress_total.mean));
   // Inertialess contacts: the overlap follows the load, below the design overlap.
   EXPECT_LT(r.max_overlap_over_radius * p.radius, hertz_overlap_under_load(p.expected_load, p.hertz_k));
+}
+
+// A run too short for 32 rows after the warm-up, with output.every left
+// automatic: the error names drive.strain (the key the user set, with its
+// line) and says what to change, not an output.every the user never wrote.
+// With output.every set, that key and its line are named.
+TEST(ImplicitRun, TooShortRunNamesTheStrainTheUserSet) {
+  const std::string file = MRF_SOURCE_DIR "/experiments/scenes/small_dem_stokes.toml";
+  try {
+    run_scene(small({"drive.strain=0.3", "drive.warmup_strain=0.1", "numerics.integrator=implicit"}),
+              RunOptions{"", true});
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(e.key(), "drive.strain") << msg;
+    EXPECT_EQ(msg.rfind("--set drive.strain=0.3: key 'drive.strain' = 0.3: ", 0), 0u) << msg;
+    for (const char* part : {"longer drive.strain", "shorter drive.warmup_strain", "output.every", "at least 32"})
+      EXPECT_NE(msg.find(part), std::string::npos) << part << " not in: " << msg;
+  }
+  try {  // the strains of the file (its lines 39, 40), a warm-up of all but 1/1000 of the run
+    run_scene(small({"drive.warmup_strain=5.994", "numerics.integrator=implicit"}), RunOptions{"", true});
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.rfind(file + ":39: key 'drive.strain' = 6: ", 0), 0u) << msg;
+  }
+  try {
+    run_scene(small({"drive.strain=0.3", "drive.warmup_strain=0.1", "numerics.integrator=implicit", "output.every=4"}),
+              RunOptions{"", true});
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), "output.every") << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind("--set output.every=4: ", 0), 0u) << e.what();
+  }
 }
 
 // Y = 2 GPa (explicit verlet_exp at dt = 1.8e-8 s), strain 5, averaged from

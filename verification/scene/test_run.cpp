@@ -356,6 +356,37 @@ TEST(RunOutput, SummaryJsonHasEveryKeyOfTheDesign) {
   EXPECT_DOUBLE_EQ(j["reynolds_number"].get<double>(), 1000 * s.shear_rate * 2.5e-6 * 2.5e-6 / k_eta);
 }
 
+// Non-magnetic particles (M = 0) with a given shear rate run, and the
+// infinite Mason number is stated, not left as a bare null (or an "inf" that
+// is no JSON): summary.json holds "mason": null beside its reason.
+TEST(RunOutput, ZeroMagnetizationRunsAndStatesTheInfiniteMasonNumber) {
+  const LoadedScene s = scene({"particles.magnetization=0", "drive.shear_rate=1e3"});
+  ASSERT_TRUE(std::isinf(s.config.mason));
+  const RunSummary r = run_scene(s, RunOptions{"", true});
+  EXPECT_TRUE(std::isinf(r.mason));
+  EXPECT_TRUE(std::isfinite(r.stress_total.mean));
+  const std::string text = summary_json(r);
+  const nlohmann::json j = nlohmann::json::parse(text);  // strict JSON
+  ASSERT_TRUE(j.contains("mason"));
+  EXPECT_TRUE(j["mason"].is_null()) << j["mason"].dump();
+  ASSERT_TRUE(j.contains("mason_note") && j["mason_note"].is_string()) << text;
+  EXPECT_NE(j["mason_note"].get<std::string>().find("particles.magnetization = 0"), std::string::npos);
+  EXPECT_EQ(j["shear_rate"].get<double>(), 1e3);
+  EXPECT_EQ(j["magnetization"].get<double>(), 0.0);
+}
+
+// The carrier fluid's viscosity and density are in summary.json (mrf
+// criterion reads the viscosity from there, through sweep.csv).
+TEST(RunOutput, SummaryJsonHasTheFluidViscosityAndDensity) {
+  const RunResult& r = base_run();
+  const nlohmann::json j = nlohmann::json::parse(r.json);
+  ASSERT_TRUE(j.contains("viscosity") && j["viscosity"].is_number()) << r.json;
+  ASSERT_TRUE(j.contains("fluid_density") && j["fluid_density"].is_number()) << r.json;
+  EXPECT_EQ(j["viscosity"].get<double>(), r.scene.config.viscosity);
+  EXPECT_EQ(j["viscosity"].get<double>(), k_eta);
+  EXPECT_EQ(j["fluid_density"].get<double>(), 1000.0);
+}
+
 TEST(RunOutput, TimeseriesHasOneRowPerOutputInterval) {
   const RunResult& r = base_run();
   const RunSummary& s = r.summary;

@@ -4,6 +4,7 @@
 // InputError that names the key, the value as written and its line.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -127,6 +128,18 @@ TEST(SceneInput, MasonAndShearRateFollowTheClosedForm) {
   const SceneConfig r = parse_scene(by_rate, "s").config;
   EXPECT_DOUBLE_EQ(r.shear_rate, 30);
   EXPECT_DOUBLE_EQ(r.mason, 9 * eta * 30 / (2 * k_mu0 * m * m));
+}
+
+// M = 0 with drive.shear_rate: non-magnetic particles (and the fluid-only
+// scenes, volume_fraction = 0) are valid; the Mason number is infinite.
+TEST(SceneInput, ZeroMagnetizationWithShearRateGivesAnInfiniteMasonNumber) {
+  const std::string text = edit(edit(k_scene, "mason =", "shear_rate = \"100 1/s\""), "magnetization =",
+                                "magnetization = 0");
+  for (const char* phi : {"0.3", "0.0"}) {
+    const LoadedScene s = parse_scene(text, "scene.toml", {std::string("particles.volume_fraction=") + phi});
+    EXPECT_EQ(s.config.shear_rate, 100) << phi;
+    EXPECT_TRUE(std::isinf(s.config.mason) && s.config.mason > 0) << phi << ": Mn = " << s.config.mason;
+  }
 }
 
 TEST(SceneInput, OptionalKeysTakeTheirDefaults) {
@@ -280,6 +293,8 @@ const Bad k_bad[] = {
     {"MasonAndShearRate", "mason =", "mason = 0.01\nshear_rate = 10", "drive.mason", "0.01",
      "only one of drive.mason and drive.shear_rate"},
     {"NoMasonNorShearRate", "mason =", "", "drive.mason", "", "missing key"},
+    {"ZeroMagnetizationWithMason", "magnetization =", "magnetization = 0", "particles.magnetization", "0",
+     "must be > 0 when drive.mason is given"},
     {"WarmupNotBelowStrain", "warmup_strain =", "warmup_strain = 5.0", "drive.warmup_strain",
      "5", "must be < drive.strain"},
     {"BadIntegrator", "integrator =", "integrator = \"rk4\"", "numerics.integrator", "\"rk4\"",

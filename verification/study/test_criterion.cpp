@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include "mrf/error.hpp"
+
 namespace mrf {
 namespace {
 
@@ -75,7 +77,8 @@ TEST(Criterion, ReadsSweepCsvSkippingFailedPoints) {
   const SweepTable t = read_sweep_csv(p.string());
   ASSERT_EQ(t.samples.at("dem_stokes").size(), 1u);
   ASSERT_EQ(t.samples.at("demsph_dd").size(), 1u);
-  EXPECT_DOUBLE_EQ(t.viscosity, 0.1);
+  EXPECT_DOUBLE_EQ(t.viscosity, 0.1);  // no viscosity column: inferred from the dem_stokes row, and said so
+  EXPECT_NE(t.viscosity_note.find("stress_fluid/shear_rate"), std::string::npos) << t.viscosity_note;
   EXPECT_DOUBLE_EQ(t.magnetization, 1e6);
   EXPECT_DOUBLE_EQ(t.samples.at("demsph_dd")[0].stress_fluid, 20);
   EXPECT_DOUBLE_EQ(t.samples.at("dem_stokes")[0].stress_volume, 80);
@@ -85,6 +88,40 @@ TEST(Criterion, ReadsSweepCsvSkippingFailedPoints) {
   ASSERT_EQ(d.size(), 1u);
   EXPECT_NEAR(d[0].mismatch, 1.0 - 50.0 / 80.0, 1e-15);
   EXPECT_NEAR(d[0].volume_value, 80.0 / 60.0 - 1.0, 1e-15);
+}
+
+// sweep.csv carries the carrier viscosity and density (from summary.json):
+// a sweep without a model-1 row has them too.
+TEST(Criterion, ReadsViscosityAndFluidDensityWithoutAModel1Row) {
+  const auto p = std::filesystem::temp_directory_path() / "mrf_test_sweep_eta.csv";
+  std::ofstream(p) << "model,mason,seed,status,shear_rate,stress_total,stress_total_err,stress_fluid,"
+                      "magnetization,volume_fraction,viscosity,fluid_density,dir\n"
+                      "demsph_dd,0.01,1,ok,100,60,2,20,1000000,0.3,0.25,960,c\n"
+                      "demsph_dd,0.1,1,ok,1000,90,2,30,1000000,0.3,0.25,960,d\n";
+  const SweepTable t = read_sweep_csv(p.string());
+  EXPECT_DOUBLE_EQ(t.viscosity, 0.25);
+  EXPECT_DOUBLE_EQ(t.fluid_density, 960);
+  EXPECT_TRUE(t.viscosity_note.empty()) << t.viscosity_note;
+  EXPECT_TRUE(std::isfinite(relative_viscosity(60, 0.01, t.viscosity, t.magnetization)));
+}
+
+// An older sweep.csv (no viscosity column) without a dem_stokes row: a clear
+// error naming the file, not eta = 0 and a 0/0 in the relative viscosity.
+TEST(Criterion, OldSweepCsvWithoutViscosityOrModel1RowIsAClearError) {
+  const auto p = std::filesystem::temp_directory_path() / "mrf_test_sweep_old.csv";
+  std::ofstream(p) << "model,mason,seed,status,shear_rate,stress_total,stress_total_err,stress_fluid,"
+                      "magnetization,volume_fraction,dir\n"
+                      "dem_stokes,0.01,1,failed,,,,,,,a\n"
+                      "demsph_dd,0.01,1,ok,100,60,2,20,1000000,0.3,c\n";
+  try {
+    const SweepTable t = read_sweep_csv(p.string());
+    FAIL() << "no error; viscosity = " << t.viscosity;
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find(p.string()), std::string::npos) << msg;
+    EXPECT_NE(msg.find("viscosity"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("dem_stokes"), std::string::npos) << msg;
+  }
 }
 
 }  // namespace

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +14,9 @@
 #include <sstream>
 
 #include "mrf/error.hpp"
+#include "mrf/io/toml_scene.hpp"
+#include "mrf/scene/run_series.hpp"
+#include "mrf/study/criterion.hpp"
 
 namespace mrf {
 namespace {
@@ -144,6 +149,89 @@ TEST(Sweep, KilledSweepResumesAndReproduces) {
 
 namespace mrf {
 namespace {
+
+// summary.json -> sweep.csv -> the criterion's table: the carrier viscosity
+// and density travel with every point, so a sweep of the SPH models alone
+// has them (the criterion used to rebuild eta from a model-1 row).
+TEST(Sweep, SweepCsvCarriesTheFluidViscosityAndDensity) {
+  const auto out = std::filesystem::temp_directory_path() / "mrf_test_sweep_fluid";
+  std::filesystem::remove_all(out);
+  const SweepSpec s = parse_sweep(
+      "[sweep]\nscene = \"small_dem_stokes.toml\"\nmodels = [\"demsph_dd\"]\nmason = [0.1]\nseeds = [1]\n"
+      "set = [\"fluid.viscosity=0.25\", \"fluid.density=960\"]\n",
+      "fluid.toml", k_scenes);
+  const auto pts = sweep_points(s);
+  ASSERT_EQ(pts.size(), 1u);
+  const LoadedScene scene = load_scene(s.scene_path, pts[0].sets);
+  std::filesystem::create_directories(out / pts[0].dir);
+  std::ofstream(out / pts[0].dir / "summary.json") << summary_json(scene_summary(scene.config));
+  const std::string csv = sweep_csv(pts, out.string());
+  std::ofstream(out / "sweep.csv") << csv;
+  const SweepTable t = read_sweep_csv((out / "sweep.csv").string());
+  EXPECT_EQ(t.viscosity, 0.25) << csv;
+  EXPECT_EQ(t.fluid_density, 960) << csv;
+  EXPECT_TRUE(t.viscosity_note.empty()) << t.viscosity_note;
+}
+
+// A Mason number with more digits than the folder label: the point's scene,
+// its summary.json and sweep.csv all hold the sweep file's value bit for bit
+// (the override used to be the 4-digit label, 0.01235 for 0.0123456789).
+TEST(Sweep, PointSceneAndSweepCsvHoldTheExactMasonNumber) {
+  const auto out = std::filesystem::temp_directory_path() / "mrf_test_sweep_mason";
+  std::filesystem::remove_all(out);
+  const SweepSpec s = parse_sweep(
+      "[sweep]\nscene = \"small_dem_stokes.toml\"\nmodels = [\"dem_stokes\"]\n"
+      "mason = [0.0123456789, 0.1, 3.3333333333333335e-5]\nseeds = [1]\n",
+      "mason.toml", k_scenes);
+  const auto pts = sweep_points(s);
+  ASSERT_EQ(pts.size(), 3u);
+  EXPECT_EQ(pts[0].mason, 0.0123456789);
+  EXPECT_EQ(pts[0].dir, "dem_stokes/mn_0.01235_seed_1");  // folder names keep 4 digits
+  for (const auto& p : pts) {
+    const LoadedScene scene = load_scene(s.scene_path, p.sets);
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(scene.config.mason), std::bit_cast<std::uint64_t>(p.mason))
+        << p.dir << ": " << scene.config.mason << " != " << p.mason;
+    std::filesystem::create_directories(out / p.dir);
+    std::ofstream(out / p.dir / "summary.json") << summary_json(scene_summary(scene.config));
+  }
+  std::istringstream csv(sweep_csv(pts, out.string()));
+  std::string line;
+  std::getline(csv, line);
+  for (const auto& p : pts) {
+    ASSERT_TRUE(std::getline(csv, line));
+    const std::string cell = line.substr(line.find(',') + 1, line.find(',', line.find(',') + 1) - line.find(',') - 1);
+    const double in_csv = std::strtod(cell.c_str(), nullptr);
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(in_csv), std::bit_cast<std::uint64_t>(p.mason)) << line;
+    std::ifstream in(out / p.dir / "summary.json");
+    const double in_summary = nlohmann::json::parse(in)["mason"].get<double>();
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(in_summary), std::bit_cast<std::uint64_t>(in_csv)) << line;
+  }
+}
+
+// An SPH spacing that does not divide the gap (80 um / 6 um) is refused for
+// the demsph_dd point before any point runs (it used to fail only when the
+// sweep reached it, after the dem_stokes point had run), naming the point,
+// the key, where it was set and the value.
+TEST(Sweep, CoupledPointWithABadSphSpacingStopsTheSweepBeforeAnyRun) {
+  const auto out = std::filesystem::temp_directory_path() / "mrf_test_sweep_sph";
+  std::filesystem::remove_all(out);
+  const SweepSpec s = parse_sweep(
+      "[sweep]\nscene = \"small_dem_stokes.toml\"\nmodels = [\"dem_stokes\", \"demsph_dd\"]\nmason = [0.1]\n"
+      "seeds = [1]\nset = [\"drive.strain=0.5\", \"drive.warmup_strain=0.1\", \"fluid.sph_spacing=6e-6\"]\n",
+      "sph.toml", k_scenes);
+  SweepOptions opt;
+  opt.quiet = true;
+  try {
+    run_sweep(s, out.string(), opt);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(e.key(), "fluid.sph_spacing") << msg;
+    for (const char* part : {"demsph_dd/mn_0.1_seed_1", "--set fluid.sph_spacing=6e-6", "6e-06", "box.gap"})
+      EXPECT_NE(msg.find(part), std::string::npos) << part << " not in: " << msg;
+  }
+  EXPECT_FALSE(std::filesystem::exists(out / "dem_stokes")) << "a point ran before the check";
+}
 
 TEST(Sweep, FailedPointCountsAsFinishedUntilItsFolderIsDeleted) {
   const auto d = std::filesystem::temp_directory_path() / "mrf_test_point";

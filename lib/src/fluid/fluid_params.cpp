@@ -22,6 +22,14 @@ void require_positive(const char* key, double v) {
   if (!(v > 0) || !std::isfinite(v)) throw InputError(key, num(v), "", "must be positive and finite");
 }
 
+// A parameter no scene sets (the solver's own setting, or a test's): the
+// error says so instead of naming a scene key the user cannot find.
+[[noreturn]] void internal_error(const char* name, double v, const std::string& why) {
+  throw InputError(std::string("FluidParams::") + name, num(v), "",
+                   why + " (an internal parameter of the SPH solver, not a scene key: the code that built the "
+                         "fluid set it)");
+}
+
 // True when length / dx is a whole number to 1e-6 relative.
 bool is_multiple(double length, double dx) {
   const double n = length / dx;
@@ -35,15 +43,17 @@ void FluidParams::validate(const Box& box) const {
   require_positive("fluid.density", density);
   require_positive("fluid.sph_spacing", spacing);
   if (!(h_over_dx >= 1.0 && h_over_dx <= 2.5))
-    throw InputError("fluid.h_over_dx", num(h_over_dx), "", "must lie in [1, 2.5]");
+    internal_error("h_over_dx", h_over_dx, "smoothing length / sph_spacing must lie in [1, 2.5]");
   if (!(sound_speed >= 0) || !std::isfinite(sound_speed))
     throw InputError("fluid.sound_speed", num(sound_speed), "", "must be >= 0 (0 = automatic)");
-  if (!std::isfinite(shear_rate)) throw InputError("drive.shear_rate", num(shear_rate), "", "must be finite");
-  if (!std::isfinite(body_force)) throw InputError("fluid.body_force", num(body_force), "", "must be finite");
+  if (!std::isfinite(shear_rate))
+    throw InputError("drive.shear_rate", num(shear_rate), "", "must be finite (given, or derived from drive.mason)");
+  if (!std::isfinite(body_force)) internal_error("body_force", body_force, "body force along z must be finite");
   if (!(density_tolerance > 0 && density_tolerance < 0.1))
-    throw InputError("fluid.density_tolerance", num(density_tolerance), "", "must lie in (0, 0.1)");
+    internal_error("density_tolerance", density_tolerance,
+                   "target density variation of the automatic sound speed must lie in (0, 0.1)");
   if (!(cg_tolerance > 0 && cg_tolerance < 1e-3))
-    throw InputError("fluid.cg_tolerance", num(cg_tolerance), "", "must lie in (0, 1e-3)");
+    internal_error("cg_tolerance", cg_tolerance, "residual of the implicit viscous solve must lie in (0, 1e-3)");
   const struct {
     const char* key;
     double length;

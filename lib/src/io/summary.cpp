@@ -1,5 +1,7 @@
 #include <nlohmann/json.hpp>
 
+#include <cmath>
+
 #include "mrf/scene/run.hpp"
 
 namespace mrf {
@@ -12,7 +14,15 @@ std::string summary_json(const RunSummary& s) {
     j[key + "_drift_z"] = m.drift_z;
   };
   j["model"] = s.model;
-  j["mason"] = s.mason;
+  // JSON has no infinity: Mn is infinite at magnetization 0 (drive.shear_rate
+  // given), written as null with the reason beside it.
+  if (std::isfinite(s.mason)) {
+    j["mason"] = s.mason;
+  } else {
+    j["mason"] = nullptr;
+    j["mason_note"] = s.magnetization == 0 ? "infinite: particles.magnetization = 0 (no magnetic forces)"
+                                           : "not finite";
+  }
   j["mason_convention"] = "Mn = 9 eta gdot / (2 mu0 M^2)";
   j["shear_rate"] = s.shear_rate;
   j["strain"] = s.strain;
@@ -43,6 +53,8 @@ std::string summary_json(const RunSummary& s) {
   j["particle_density"] = s.density;
   j["magnetization"] = s.magnetization;
   j["volume_fraction"] = s.volume_fraction;
+  j["viscosity"] = s.viscosity;          // Pa s, the carrier fluid's (mrf criterion reads it)
+  j["fluid_density"] = s.fluid_density;  // kg/m^3
   j["seed"] = s.seed;
   for (const auto& [key, value] : s.extra) j[key] = value;
   j["version"] = MRF_VERSION;

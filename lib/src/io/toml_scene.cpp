@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <optional>
 #include <sstream>
 
@@ -373,7 +374,8 @@ const Rule k_rules[] = {
      }},
     {"particles.magnetization", [](const C& c, const Given& g) {
        return unless(c.magnetization > 0 || !g.count("drive.mason"),
-                     "must be > 0 when drive.mason is given");
+                     "must be > 0 when drive.mason is given (at M = 0, Mn = 9 eta gdot / (2 mu0 M^2) fixes no "
+                     "shear rate; give drive.shear_rate for non-magnetic particles)");
      }},
     {"particles.dipole_cutoff", [](const C& c, const Given&) {
        return unless(c.dipole_cutoff >= 2 * c.radius,
@@ -410,8 +412,9 @@ void validate(const LoadedScene& s, const Given& given) {
 void fill_drive(C& c, const Given& given) {
   if (given.count("drive.mason"))
     c.shear_rate = shear_rate_from_mason(c.mason, c.viscosity, c.magnetization);
-  else
-    c.mason = mason_from_shear_rate(c.shear_rate, c.viscosity, c.magnetization);
+  else  // M = 0 (allowed with shear_rate): Mn is infinite, stated rather than left to a division by zero
+    c.mason = c.magnetization > 0 ? mason_from_shear_rate(c.shear_rate, c.viscosity, c.magnetization)
+                                  : std::numeric_limits<double>::infinity();
 }
 
 }  // namespace

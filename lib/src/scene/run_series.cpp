@@ -81,6 +81,8 @@ RunSummary scene_summary(const SceneConfig& c) {
   s.density = c.density;
   s.magnetization = c.magnetization;
   s.volume_fraction = c.volume_fraction;
+  s.viscosity = c.viscosity;
+  s.fluid_density = c.fluid_density;
   s.seed = c.seed;
   s.threads = omp_get_max_threads();
   return s;
@@ -110,13 +112,32 @@ void write_frame(std::ostream& out, const ShearCell& cell, double radius, double
 
 long series_every(const LoadedScene& scene, long steps) {
   const SceneConfig& c = scene.config;
-  const long every = c.every > 0 ? c.every : std::max(1L, steps / 2000);
+  const bool automatic = c.every <= 0;  // output.every not set (or 0): about 2000 rows per run
+  const long every = automatic ? std::max(1L, steps / 2000) : c.every;
   const double rows_after_warmup = (1.0 - c.warmup_strain / c.strain) * static_cast<double>(steps / every);
-  if (rows_after_warmup < 32)
+  if (rows_after_warmup >= 32) return every;
+  const std::string rows = std::to_string(static_cast<long>(rows_after_warmup));
+  auto num = [](double x) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.4g", x);
+    return std::string(buf);
+  };
+  if (!automatic)
     throw InputError("output.every", std::to_string(every), scene.locate("output.every"),
-                     "leaves only " + std::to_string(static_cast<long>(rows_after_warmup)) +
-                         " time-series rows after the warm-up; block averaging needs at least 32");
-  return every;
+                     "leaves only " + rows +
+                         " time-series rows after the warm-up; block averaging needs at least 32 (set a smaller "
+                         "output.every, a longer drive.strain or a shorter drive.warmup_strain)");
+  // output.every is automatic: the user set the strains, so name drive.strain and what to change.
+  const double strain_per_row = c.strain * static_cast<double>(every) / static_cast<double>(std::max(1L, steps));
+  const double strain_needed = c.warmup_strain + 32.0 * strain_per_row;
+  std::string why = "with drive.warmup_strain = " + num(c.warmup_strain) + " (" + scene.locate("drive.warmup_strain") +
+                    ") leaves only " + rows + " time-series rows after the warm-up (one row per strain " +
+                    num(strain_per_row) + ", " + std::to_string(steps / every) +
+                    " in all); block averaging needs at least 32: give a longer drive.strain (at least about " +
+                    num(strain_needed) + ") or a shorter drive.warmup_strain";
+  why += every > 1 ? ", or set output.every below the automatic " + std::to_string(every) + " steps per row"
+                   : " (output.every cannot add rows: they are already one per time step)";
+  throw InputError("drive.strain", num(c.strain), scene.locate("drive.strain"), why);
 }
 
 std::string scene_fingerprint(const SceneConfig& c) {

@@ -1,6 +1,7 @@
 #include "mrf/study/criterion.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -32,6 +33,8 @@ SweepTable read_sweep_csv(const std::string& path) {
                         "magnetization", "volume_fraction"})
     if (!col.count(k)) throw InputError("sweep.csv", path, "", std::string("missing column ") + k);
   SweepTable t;
+  double inferred = 0;  // eta from a dem_stokes row, for a sweep.csv without viscosity
+  std::string inferred_from;
   int line_no = 1;
   while (std::getline(in, line)) {
     ++line_no;
@@ -52,12 +55,36 @@ SweepTable read_sweep_csv(const std::string& path) {
       s.stress_volume = std::stod(c[col["stress_virial_total"]]);
     t.magnetization = std::stod(c[col["magnetization"]]);
     t.volume_fraction = std::stod(c[col["volume_fraction"]]);
-    // eta from the first row: tau_fluid of model 1 is eta gdot, and gdot follows from Mn
-    if (t.viscosity == 0 && c[col["model"]] == "dem_stokes" && col.count("shear_rate"))
-      t.viscosity = s.stress_fluid / std::stod(c[col["shear_rate"]]);
+    if (t.viscosity == 0 && col.count("viscosity") && !c[col["viscosity"]].empty())
+      t.viscosity = std::stod(c[col["viscosity"]]);
+    if (t.fluid_density == 0 && col.count("fluid_density") && !c[col["fluid_density"]].empty())
+      t.fluid_density = std::stod(c[col["fluid_density"]]);
+    // no viscosity column (sweep.csv of an earlier mrf): tau_fluid of model 1 is eta gdot
+    if (inferred == 0 && c[col["model"]] == "dem_stokes" && col.count("shear_rate") && !c[col["shear_rate"]].empty()) {
+      const double gdot = std::stod(c[col["shear_rate"]]);
+      if (gdot > 0 && s.stress_fluid > 0) {
+        inferred = s.stress_fluid / gdot;
+        inferred_from = path + ":" + std::to_string(line_no);
+      }
+    }
     t.samples[c[col["model"]]].push_back(s);
   }
-  return t;
+  if (t.viscosity > 0 || t.samples.empty()) return t;
+  if (inferred > 0) {
+    t.viscosity = inferred;
+    char eta[32];
+    std::snprintf(eta, sizeof eta, "%.6g", inferred);
+    t.viscosity_note = "sweep.csv has no viscosity value (written by an mrf whose summary.json lacked it): eta = " +
+                       std::string(eta) + " Pa s inferred as stress_fluid/shear_rate of the dem_stokes row " +
+                       inferred_from;
+    return t;
+  }
+  throw InputError("sweep.csv", path, "",
+                   "has no viscosity value (no or an empty viscosity column: written by an mrf whose summary.json lacked "
+                   "the fluid viscosity) and no "
+                   "ok dem_stokes row to infer it from (model 1's fluid stress is eta * shear_rate; the SPH models' is "
+                   "not); the flow curves need it: rerun the points with this mrf (summary.json then carries "
+                   "viscosity) or add a viscosity column in Pa s");
 }
 
 std::vector<Deviation> deviation(const std::vector<FlowPoint>& model, const std::vector<FlowPoint>& ref) {

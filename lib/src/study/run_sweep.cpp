@@ -8,7 +8,10 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include "mrf/box.hpp"
 #include "mrf/error.hpp"
+#include "mrf/fluid/couette_sph.hpp"
+#include "mrf/io/quantity.hpp"
 #include "mrf/scene/dem_params.hpp"
 #include "mrf/scene/build_model.hpp"
 #include "mrf/scene/run.hpp"
@@ -31,6 +34,23 @@ double estimate_seconds(const LoadedScene& scene, double cost_rate) {
     particles += volume / (c.sph_spacing * c.sph_spacing * c.sph_spacing);
   const double steps = c.strain / (c.shear_rate * ts.dt);
   return steps * particles / cost_rate;
+}
+
+// What the coupled and fluid-only runs check first (FluidParams::validate of
+// the scene's fluid against the box, in build_fluid_cell), done here for
+// every SPH point before any point runs, so that a bad sph_spacing does not
+// surface only when the sweep reaches the point. The error names the point,
+// the key with its location and the value.
+void validate_point_fluid(const SweepPoint& p, const LoadedScene& scene) {
+  const SceneConfig& c = scene.config;
+  if (c.model == ModelId::dem_stokes) return;  // no fluid
+  try {
+    fluid_params_from_scene(c).validate(Box{c.gap, c.ly, c.lz});
+  } catch (const InputError& e) {
+    throw InputError(e.key(), "", scene.locate(e.key()),
+                     "sweep point " + p.dir + " (" + p.model + ", Mn " + format_number(p.mason) + ", seed " +
+                         std::to_string(p.seed) + "): " + e.what());
+  }
 }
 
 std::string format_seconds(double s) {
@@ -69,6 +89,7 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
       continue;
     }
     LoadedScene scene = load_scene(spec.scene_path, p.sets);  // input errors stop the sweep here
+    validate_point_fluid(p, scene);                             // and those of the fluid of a coupled model
     double est = std::numeric_limits<double>::quiet_NaN();
     try {
       est = estimate_seconds(scene, opt.cost_rate);

@@ -13,6 +13,7 @@
 
 #include "mrf/error.hpp"
 #include "mrf/io/atomic_file.hpp"
+#include "mrf/io/quantity.hpp"
 #include "mrf/scene/config.hpp"
 
 namespace mrf {
@@ -64,6 +65,7 @@ double positive_number(const toml::node& n, const std::string& key, const std::s
   return *v;
 }
 
+// Folder names only: 4 digits. The point's scene gets the exact value (format_number).
 std::string mason_label(double mn) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.4g", mn);
@@ -162,7 +164,7 @@ std::vector<SweepPoint> sweep_points(const SweepSpec& spec) {
           if (model_ok && mn_ok) p.sets.insert(p.sets.end(), r.set.begin(), r.set.end());
         }
         p.sets.push_back("scene.model=\"" + model + "\"");
-        p.sets.push_back("drive.mason=" + mason_label(mn));
+        p.sets.push_back("drive.mason=" + format_number(mn));  // reads back exactly: the run and sweep.csv agree
         p.sets.push_back("scene.seed=" + std::to_string(seed));
         p.dir = model + "/mn_" + mason_label(mn) + "_seed_" + std::to_string(seed);
         out.push_back(std::move(p));
@@ -206,7 +208,7 @@ std::string sweep_csv(const std::vector<SweepPoint>& points, const std::string& 
                                   "stress_virial_magnetic",
                                   "stress_virial_contact", "n_particles", "n_fluid", "dt", "steps", "wall_seconds",
                                   "stokes_number", "reynolds_number", "max_overlap_over_radius", "volume_fraction",
-                                  "magnetization", "youngs_modulus"};
+                                  "magnetization", "youngs_modulus", "viscosity", "fluid_density"};
   std::ostringstream csv;
   csv.precision(10);
   csv << "model,mason,seed,status";
@@ -224,7 +226,7 @@ std::string sweep_csv(const std::vector<SweepPoint>& points, const std::string& 
     } else {
       continue;
     }
-    csv << p.model << "," << p.mason << "," << p.seed << "," << status;
+    csv << p.model << "," << format_number(p.mason) << "," << p.seed << "," << status;
     for (const char* k : numbers) {
       csv << ",";
       if (status == "ok" && j.contains(k) && j[k].is_number()) csv << j[k].get<double>();

@@ -17,7 +17,10 @@ struct FluidParams {
   double density_tolerance = 0.01; // delta, target relative density variation (1)
   double cg_tolerance = 1e-10;     // relative residual of the implicit viscous solve (1)
 
-  // Throws InputError naming the scene key (fluid.viscosity, ...). Requires
+  // Throws InputError naming the scene key (fluid.viscosity, fluid.density,
+  // fluid.sph_spacing, fluid.sound_speed, drive.shear_rate, box.*); the
+  // parameters no scene sets (h_over_dx, body_force, density_tolerance,
+  // cg_tolerance) are named "FluidParams::<name>" and said to be internal. Requires
   // gap, ly and lz to be whole multiples of the spacing (the lattice and the
   // wall layers must tile the periodic box) and ly, lz larger than the kernel
   // support 2h (so no particle sees its own periodic image).

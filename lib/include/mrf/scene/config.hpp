@@ -38,6 +38,8 @@ struct SceneConfig {
   double sound_speed = 0;      // m/s (SPH models only; 0 = choose from 1 % density variation)
   // [drive]: exactly one of mason, shear_rate is given in the file; both are
   // filled in after validation (Mn = 9 eta gdot / (2 mu0 M^2), DESIGN.md).
+  // Mn = +inf for drive.shear_rate with magnetization = 0 (no magnetic
+  // forces); drive.mason with magnetization = 0 is refused.
   double mason = 0;
   double shear_rate = 0;       // 1/s
   double strain = 0;           // total strain of the run

@@ -46,6 +46,7 @@ struct RunSummary {
   double wall_seconds = 0, particle_steps_per_second = 0, pair_evaluations_per_second = 0;
   double stokes_number = 0, reynolds_number = 0, max_overlap_over_radius = 0;
   double youngs_modulus = 0, density = 0, magnetization = 0, volume_fraction = 0;
+  double viscosity = 0, fluid_density = 0;  // carrier fluid: Pa s, kg/m^3
   std::uint64_t seed = 0;
   int threads = 1;
   std::map<std::string, double> extra;  // model-specific keys, written into summary.json as they are

@@ -56,7 +56,7 @@ class StressSeries {
 };
 
 // The fields of summary.json that come from the scene alone (model, Mn,
-// shear rate, strains, material, seed) and the thread count.
+// shear rate, strains, material, carrier fluid, seed) and the thread count.
 RunSummary scene_summary(const SceneConfig& c);
 
 void write_series_header(std::ostream& out);
@@ -66,7 +66,9 @@ void write_series_row(std::ostream& out, double time, double strain, const Serie
 void write_frame(std::ostream& out, const ShearCell& cell, double radius, double time);
 
 // Steps between rows (output.every or ~2000 rows) and the check that at
-// least 32 rows follow the warm-up; throws InputError on output.every.
+// least 32 rows follow the warm-up; throws InputError on output.every when
+// the user set it, else on drive.strain (with what to change: a longer
+// drive.strain, a shorter drive.warmup_strain, output.every where it helps).
 long series_every(const LoadedScene& scene, long steps);
 
 // What a run loop carries from one row to the next (checkpointed).

@@ -27,12 +27,19 @@
 
 namespace mrf {
 
-// sweep.csv rows with status ok, grouped by model (magnetization and
-// viscosity taken from the rows; all rows of a sweep share them).
+// sweep.csv rows with status ok, grouped by model (magnetization, carrier
+// viscosity and density taken from the rows; all rows of a sweep share them).
 struct SweepTable {
   std::map<std::string, std::vector<StressSample>> samples;  // by model
-  double magnetization = 0, viscosity = 0, volume_fraction = 0;
+  double magnetization = 0, viscosity = 0, fluid_density = 0, volume_fraction = 0;  // A/m, Pa s, kg/m^3, 1
+  std::string viscosity_note;  // how the viscosity was found when sweep.csv has no viscosity value
 };
+// The viscosity comes from the `viscosity` column (summary.json's since it
+// carries the fluid viscosity). A sweep.csv of an earlier mrf has none: then
+// eta = stress_fluid / shear_rate of the first ok dem_stokes row (model 1's
+// imposed flow carries exactly eta gdot), with viscosity_note saying so; an
+// InputError when such a sweep has rows but no dem_stokes row to infer it
+// from. fluid_density is 0 when sweep.csv has no such column.
 SweepTable read_sweep_csv(const std::string& path);
 
 struct Deviation {

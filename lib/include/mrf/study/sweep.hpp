@@ -95,8 +95,9 @@ struct SweepOutcome {
 double estimate_point_seconds(const std::string& scene_path, const std::vector<std::string>& sets, double cost_rate);
 
 // Runs this rank's unfinished points one after another into out_dir/<point.dir>
-// (every scene is loaded and validated before the first run, so an input
-// error stops the sweep at once). A point that fails numerically leaves
+// (every scene is loaded and validated before the first run, and so is the
+// fluid of every SPH point against its box, as the coupled run checks it: an
+// input error stops the sweep at once, naming the point). A point that fails numerically leaves
 // failure.json with the message and the sweep goes on; a finished point is
 // skipped. Progress and an estimate of the time left go to stderr. At the
 // end out_dir/sweep.csv is rewritten (atomically) from every finished point.
