@@ -10,7 +10,7 @@
 
 #include "mrf/box.hpp"
 #include "mrf/error.hpp"
-#include "mrf/fluid/couette_sph.hpp"
+#include "mrf/scene/fluid_only.hpp"
 #include "mrf/io/quantity.hpp"
 #include "mrf/scene/dem_params.hpp"
 #include "mrf/scene/build_model.hpp"
