@@ -37,6 +37,22 @@ void FluidResponse::set(std::size_t n_dem, const std::vector<CouplingPair>& pair
     merged[i + 1] = static_cast<std::uint32_t>(a_.size());
   }
   start_ = std::move(merged);
+  // The same entries by SPH particle (CSR over a), so that the scatter is a
+  // gather too: both passes run on threads without write conflicts, each
+  // sum in a fixed order.
+  const std::size_t na = rho.size();
+  rstart_.assign(na + 1, 0);
+  for (std::uint32_t b : a_) ++rstart_[b + 1];
+  for (std::size_t b = 0; b < na; ++b) rstart_[b + 1] += rstart_[b];
+  rdem_.resize(a_.size());
+  rscatter_.resize(a_.size());
+  std::vector<std::uint32_t> fill(rstart_.begin(), rstart_.end() - 1);
+  for (std::size_t i = 0; i < n_dem; ++i)
+    for (std::uint32_t e = start_[i]; e < start_[i + 1]; ++e) {
+      const std::uint32_t slot = fill[a_[e]]++;
+      rdem_[slot] = static_cast<std::uint32_t>(i);
+      rscatter_[slot] = scatter_[e];
+    }
   diag_.assign(n_dem, 0.0);
   for (std::size_t i = 0; i < n_dem; ++i)
     for (std::uint32_t e = start_[i]; e < start_[i + 1]; ++e) diag_[i] += gather_[e] * scatter_[e];
@@ -59,31 +75,37 @@ double FluidResponse::coupling(std::size_t i, std::size_t k) const {
   return c;
 }
 
-void FluidResponse::add(const std::vector<Vec3>& f, double scale, std::vector<Vec3>& y) {
-  // Raw arrays, z by component: the two passes are the cost of a coupled
-  // contact solve (one per CG iteration).
-  const std::size_t n = f.size(), nz = z_.size() / 3;
-  std::fill(z_.begin(), z_.end(), 0.0);
+void FluidResponse::add(const std::vector<Vec3>& f, double scale, std::vector<Vec3>& y,
+                        const std::vector<std::uint32_t>* rows) {
+  // z_a = sum_j W_aj f_j / (rho_a s_j), then y_i += scale sum_a m W_ia z_a /
+  // (rho_a s_i): two gathers (by SPH particle, by DEM particle), the cost of
+  // a coupled contact solve (one per CG iteration). Raw arrays, z by
+  // component; OpenMP over the outer index, so each sum keeps its order.
+  const std::size_t n = f.size(), na = rstart_.size() - 1;
   double* zx = z_.data();
-  double* zy = zx + nz;
-  double* zz = zy + nz;
+  double* zy = zx + na;
+  double* zz = zy + na;
   const std::uint32_t* a = a_.data();
-  const double* sc = scatter_.data();
+  const std::uint32_t* rj = rdem_.data();
+  const double* rs = rscatter_.data();
   const double* ga = gather_.data();
-  bool any = false;
-  for (std::size_t j = 0; j < n; ++j) {
-    const double fx = f[j].x(), fy = f[j].y(), fz = f[j].z();
-    if (fx == 0 && fy == 0 && fz == 0) continue;
-    any = true;
-    for (std::uint32_t e = start_[j], end = start_[j + 1]; e < end; ++e) {
-      const std::uint32_t b = a[e];
-      zx[b] += sc[e] * fx;
-      zy[b] += sc[e] * fy;
-      zz[b] += sc[e] * fz;
+  const Vec3* fv = f.data();
+  const bool threads = a_.size() > k_entries_per_thread;
+#pragma omp parallel for schedule(static) if (threads)
+  for (std::size_t b = 0; b < na; ++b) {
+    double sx = 0, sy = 0, sz = 0;
+    for (std::uint32_t e = rstart_[b], end = rstart_[b + 1]; e < end; ++e) {
+      const Vec3& fj = fv[rj[e]];
+      sx += rs[e] * fj.x();
+      sy += rs[e] * fj.y();
+      sz += rs[e] * fj.z();
     }
+    zx[b] = sx, zy[b] = sy, zz[b] = sz;
   }
-  if (!any) return;
-  for (std::size_t i = 0; i < n; ++i) {
+  const std::size_t m = rows ? rows->size() : n;
+#pragma omp parallel for schedule(static) if (threads)
+  for (std::size_t r = 0; r < m; ++r) {
+    const std::size_t i = rows ? (*rows)[r] : r;
     double sx = 0, sy = 0, sz = 0;
     for (std::uint32_t e = start_[i], end = start_[i + 1]; e < end; ++e) {
       const std::uint32_t b = a[e];

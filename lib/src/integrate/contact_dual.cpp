@@ -18,7 +18,7 @@ Vec3 pair_vector(const ContactPair& c, const std::vector<Vec3>& x, const WallPar
 }  // namespace
 
 void ContactDual::move(const std::vector<ContactPair>& pairs, const std::vector<double>& q, bool active_only,
-                       std::vector<Vec3>& y) {
+                       std::vector<Vec3>& y, bool contact_rows_only) {
   const std::vector<double>& mob = *mob_;
   const std::size_t m = active_only ? act_.size() : pairs.size();
   if (coupled_) s_.assign(y.size(), Vec3::Zero());
@@ -34,7 +34,7 @@ void ContactDual::move(const std::vector<ContactPair>& pairs, const std::vector<
       if (!pc.wall) s_[pc.k] -= f;
     }
   }
-  if (coupled_) coupled_->add(s_, coupled_scale_, y);
+  if (coupled_) coupled_->add(s_, coupled_scale_, y, contact_rows_only ? &act_particles_ : nullptr);
 }
 
 void ContactDual::add_forces(const std::vector<ContactPair>& pairs, std::vector<Vec3>& f) const {
@@ -55,7 +55,7 @@ void ContactDual::apply(const std::vector<ContactPair>& pairs, const std::vector
   const std::vector<double>& mob = *mob_;
   if (coupled_) {
     std::fill(disp_.begin(), disp_.end(), Vec3::Zero());
-    move(pairs, p, true, disp_);
+    move(pairs, p, true, disp_, true);  // only the spheres of active contacts are read back
   } else {
     for (std::size_t a = 0; a < act_.size(); ++a) {
       const ContactPair& c = pairs[act_[a]];
@@ -155,6 +155,13 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
       act_.push_back(static_cast<std::uint32_t>(c));
       if (std::abs(phi) > worst) worst = std::abs(phi), res.worst = pc.i;
     }
+    act_particles_.clear();
+    for (auto c : act_) {
+      act_particles_.push_back(pairs[c].i);
+      if (!pairs[c].wall) act_particles_.push_back(pairs[c].k);
+    }
+    std::sort(act_particles_.begin(), act_particles_.end());
+    act_particles_.erase(std::unique(act_particles_.begin(), act_particles_.end()), act_particles_.end());
     y_next_ = b;
     move(pairs, lambda_, false, y_next_);
     // y was placed with the normals of the last iterate; with the normals

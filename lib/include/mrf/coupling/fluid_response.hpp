@@ -27,9 +27,10 @@ class FluidResponse final : public MobilityCoupling {
   // density rho_a that divides the SPH sums and the SPH particle mass (kg).
   void set(std::size_t n_dem, const std::vector<CouplingPair>& pairs, const std::vector<double>& s,
            const std::vector<double>& rho, double mass);
-  // y_i += scale sum_j C_ij f_j for every particle i (scale in the unit
-  // that turns 1/kg x f into y). Particles with f_j = 0 cost nothing.
-  void add(const std::vector<Vec3>& f, double scale, std::vector<Vec3>& y) override;
+  // y_i += scale sum_j C_ij f_j for every particle i, or those in `rows`
+  // (scale in the unit that turns 1/kg x f into y).
+  void add(const std::vector<Vec3>& f, double scale, std::vector<Vec3>& y,
+           const std::vector<std::uint32_t>* rows = nullptr) override;
   // C_ii and C_ik (1/kg).
   double diagonal(std::size_t i) const override { return diag_[i]; }
   double coupling(std::size_t i, std::size_t k) const override;
@@ -41,6 +42,11 @@ class FluidResponse final : public MobilityCoupling {
   std::vector<std::uint32_t> a_;
   std::vector<double> scatter_, gather_;
   std::vector<std::uint32_t> start_;  // pairs of DEM particle i: [start_[i], start_[i + 1])
+  std::vector<std::uint32_t> rstart_, rdem_;  // the entries by SPH particle: DEM index
+  std::vector<double> rscatter_;              // and scatter weight
+  // Threads only where there is work for them (a parallel region costs a
+  // few microseconds); the choice depends on the pairs alone.
+  static constexpr std::size_t k_entries_per_thread = 20000;
   std::vector<double> diag_;
   std::vector<double> z_;             // per SPH particle, by component: sum_j W_aj f_j / (rho_a s_j)
   std::vector<std::uint32_t> order_;  // scratch of set()

@@ -4,6 +4,7 @@
 // coupling/fluid_response.hpp). The diagonal part stays a per-particle array.
 #pragma once
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "mrf/vec.hpp"
@@ -12,8 +13,9 @@ namespace mrf {
 
 class MobilityCoupling {
  public:
-  // y_i += scale sum_j C_ij f_j.
-  virtual void add(const std::vector<Vec3>& f, double scale, std::vector<Vec3>& y) = 0;
+  // y_i += scale sum_j C_ij f_j, for every i or only those listed in `rows`.
+  virtual void add(const std::vector<Vec3>& f, double scale, std::vector<Vec3>& y,
+                   const std::vector<std::uint32_t>* rows = nullptr) = 0;
   virtual double diagonal(std::size_t i) const = 0;                 // C_ii
   virtual double coupling(std::size_t i, std::size_t k) const = 0;  // C_ik
 
