@@ -16,7 +16,7 @@
 #include "mrf/integrate/stability.hpp"
 #include "mrf/integrate/steps.hpp"
 #include "mrf/scene/dem_model.hpp"
-#include "mrf/scene/run.hpp"
+#include "mrf/scene/run_series.hpp"
 
 namespace mrf {
 
@@ -145,14 +145,7 @@ void CoupledModel::finish(RunSummary& s) const {
   s.extra["momentum_drift_relative"] = scale > 0 ? drift.norm() / scale : 0.0;
   s.extra["sph_wall_reflections"] = static_cast<double>(sums_.wall_reflections);
   if (implicit_) {
-    const ImplicitCounters& ic = implicit_->counters();
-    s.extra["implicit_rejected_steps"] = static_cast<double>(ic.rejected);
-    s.extra["implicit_newton_failures"] = static_cast<double>(ic.newton_failures);
-    s.extra["implicit_newton_iterations"] = static_cast<double>(ic.newton_iterations);
-    s.extra["implicit_linear_iterations"] = static_cast<double>(ic.linear_iterations);
-    s.extra["implicit_dt_min"] = ic.dt_min;
-    s.extra["implicit_dt_max"] = ic.dt_max;
-    s.extra["implicit_dt_mean"] = time_ / static_cast<double>(std::max(1L, steps_));
+    report_implicit(implicit_->counters(), time_, steps_, s);
     s.extra["fluid_steps"] = static_cast<double>(fluid_substeps_);
     s.extra["sph_pair_builds"] = static_cast<double>(sph_pairs_.builds);
     if (stepping_.implicit_viscosity) s.extra["viscous_cg_iterations"] = static_cast<double>(viscous_iterations_);

@@ -6,10 +6,10 @@
 #include <string>
 
 #include "mrf/error.hpp"
-#include "mrf/observe/stress.hpp"
 #include "mrf/forces/hertz.hpp"
 #include "mrf/integrate/steps.hpp"
-#include "mrf/scene/run.hpp"
+#include "mrf/observe/stress.hpp"
+#include "mrf/scene/run_series.hpp"
 
 namespace mrf {
 
@@ -102,15 +102,7 @@ StepSample DemModel::sample() const {
 }
 
 void DemModel::finish(RunSummary& s) const {
-  if (!implicit_) return;
-  const ImplicitCounters& ic = implicit_->counters();
-  s.extra["implicit_rejected_steps"] = static_cast<double>(ic.rejected);
-  s.extra["implicit_newton_failures"] = static_cast<double>(ic.newton_failures);
-  s.extra["implicit_newton_iterations"] = static_cast<double>(ic.newton_iterations);
-  s.extra["implicit_linear_iterations"] = static_cast<double>(ic.linear_iterations);
-  s.extra["implicit_dt_min"] = ic.dt_min;
-  s.extra["implicit_dt_max"] = ic.dt_max;
-  s.extra["implicit_dt_mean"] = time_ / static_cast<double>(std::max(1L, steps_));
+  if (implicit_) report_implicit(implicit_->counters(), time_, steps_, s);
 }
 
 void DemModel::check_finite_positions() const {

@@ -1,21 +1,15 @@
 #include "mrf/scene/run.hpp"
 
-#include <omp.h>
-
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
-#include "mrf/error.hpp"
-#include "mrf/scene/fluid_only.hpp"
-#include "mrf/forces/drag.hpp"
 #include "mrf/io/archive.hpp"
 #include "mrf/io/atomic_file.hpp"
-#include "mrf/observe/stress.hpp"
 #include "mrf/scene/build_model.hpp"
+#include "mrf/scene/fluid_only.hpp"
 #include "mrf/scene/run_series.hpp"
 
 namespace mrf {

@@ -88,6 +88,16 @@ RunSummary scene_summary(const SceneConfig& c) {
   return s;
 }
 
+void report_implicit(const ImplicitCounters& c, double time, long steps, RunSummary& s) {
+  s.extra["implicit_rejected_steps"] = static_cast<double>(c.rejected);
+  s.extra["implicit_newton_failures"] = static_cast<double>(c.newton_failures);
+  s.extra["implicit_newton_iterations"] = static_cast<double>(c.newton_iterations);
+  s.extra["implicit_linear_iterations"] = static_cast<double>(c.linear_iterations);
+  s.extra["implicit_dt_min"] = c.dt_min;
+  s.extra["implicit_dt_max"] = c.dt_max;
+  s.extra["implicit_dt_mean"] = time / static_cast<double>(std::max(1L, steps));
+}
+
 void write_series_header(std::ostream& out) {
   out << "time_s,strain,stress_total_Pa,stress_particles_Pa,stress_fluid_Pa,"
          "stress_virial_magnetic_Pa,stress_virial_contact_Pa,max_overlap_over_radius,"

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "mrf/integrate/implicit_stepper.hpp"
 #include "mrf/io/archive.hpp"
 #include "mrf/scene/dem_forces.hpp"
 #include "mrf/scene/run.hpp"
@@ -58,6 +59,11 @@ class StressSeries {
 // The fields of summary.json that come from the scene alone (model, Mn,
 // shear rate, strains, material, carrier fluid, seed) and the thread count.
 RunSummary scene_summary(const SceneConfig& c);
+
+// The implicit scheme's work in summary.json: implicit_rejected_steps,
+// _newton_failures, _newton_iterations, _linear_iterations, _dt_min/max and
+// _dt_mean (time / steps).
+void report_implicit(const ImplicitCounters& c, double time, long steps, RunSummary& s);
 
 void write_series_header(std::ostream& out);
 void write_series_row(std::ostream& out, double time, double strain, const SeriesRow& row, double radius);
