@@ -1,5 +1,6 @@
 #include "mrf/fluid/fluid_cell.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "mrf/fluid/kernel.hpp"
@@ -128,28 +129,48 @@ void update_pairs(FluidCell& cell, SphPairCache& cache) {
   const double dw = stale ? 0.0 : max_displacement(cell.wall.x, cache.x_wall, box);
   if (stale || 2.0 * df > cache.skin || df + dw > cache.skin) {
     cache.candidates = find_pairs(cell, rc + cache.skin);
+    // Sorted by (a, b, image), so that the pairs, and the round-off of every
+    // sum over them, do not depend on when the candidates were built (a
+    // resumed run rebuilds them at once).
+    auto order = [](const SphPair& p, const SphPair& q) {
+      if (p.a != q.a) return p.a < q.a;
+      if (p.b != q.b) return p.b < q.b;
+      if (p.r_ab.y() != q.r_ab.y()) return p.r_ab.y() < q.r_ab.y();
+      return p.r_ab.z() < q.r_ab.z();
+    };
+    std::sort(cache.candidates.fluid_fluid.begin(), cache.candidates.fluid_fluid.end(), order);
+    std::sort(cache.candidates.fluid_wall.begin(), cache.candidates.fluid_wall.end(), order);
     cache.x_fluid = cell.fluid.x;
     cache.x_wall = cell.wall.x;
     ++cache.builds;
   }
+  // The separation is computed as find_pairs does (minimum image, then the
+  // image of the candidate: the one nearest to its reference separation
+  // moved by the displacements), so the pairs equal a fresh search bit for bit.
   const MinImageYZ mi(box);
   auto moved = [&](const Vec3& x, const Vec3& ref) {
     return Vec3(x.x() - ref.x(), mi.wrap_y(x.y() - ref.y()), mi.wrap_z(x.z() - ref.z()));
   };
   const double rc2 = rc * rc;
+  auto add = [&](const SphPair& c, const Vec3& xa, const Vec3& xb, const Vec3& predicted, std::vector<SphPair>& out) {
+    const Vec3 d = xa - xb;
+    const Vec3 m(d.x(), mi.wrap_y(d.y()), mi.wrap_z(d.z()));
+    const double iy = std::nearbyint((predicted.y() - m.y()) / box.ly), iz = std::nearbyint((predicted.z() - m.z()) / box.lz);
+    const double ey = m.y() + static_cast<int>(iy) * box.ly, ez = m.z() + static_cast<int>(iz) * box.lz;
+    const double r2 = m.x() * m.x() + ey * ey + ez * ez;
+    if (r2 < rc2) out.push_back({c.a, c.b, Vec3(m.x(), ey, ez), std::sqrt(r2)});
+  };
   SphPairs& out = cell.pairs;
   out.fluid_fluid.clear();
   out.fluid_wall.clear();
-  for (const SphPair& c : cache.candidates.fluid_fluid) {
-    const Vec3 r = c.r_ab + moved(cell.fluid.x[c.a], cache.x_fluid[c.a]) - moved(cell.fluid.x[c.b], cache.x_fluid[c.b]);
-    const double r2 = r.squaredNorm();
-    if (r2 < rc2) out.fluid_fluid.push_back({c.a, c.b, r, std::sqrt(r2)});
-  }
-  for (const SphPair& c : cache.candidates.fluid_wall) {
-    const Vec3 r = c.r_ab + moved(cell.fluid.x[c.a], cache.x_fluid[c.a]) - moved(cell.wall.x[c.b], cache.x_wall[c.b]);
-    const double r2 = r.squaredNorm();
-    if (r2 < rc2) out.fluid_wall.push_back({c.a, c.b, r, std::sqrt(r2)});
-  }
+  for (const SphPair& c : cache.candidates.fluid_fluid)
+    add(c, cell.fluid.x[c.a], cell.fluid.x[c.b],
+        c.r_ab + moved(cell.fluid.x[c.a], cache.x_fluid[c.a]) - moved(cell.fluid.x[c.b], cache.x_fluid[c.b]),
+        out.fluid_fluid);
+  for (const SphPair& c : cache.candidates.fluid_wall)
+    add(c, cell.fluid.x[c.a], cell.wall.x[c.b],
+        c.r_ab + moved(cell.fluid.x[c.a], cache.x_fluid[c.a]) - moved(cell.wall.x[c.b], cache.x_wall[c.b]),
+        out.fluid_wall);
 }
 
 }  // namespace mrf

@@ -176,27 +176,4 @@ void ImplicitStepper::contact_forces_end(const FreeParticles& f, const WallParti
   }
 }
 
-void ImplicitStepper::save(ArchiveWriter& out) const {
-  out.put(dt_);
-  out.put(dt_try_);
-  out.put(counters_);
-  out.put(x_prev_);
-  out.put(x_prev2_);
-  out.put(w_prev_);
-  out.put(dt_prev2_);
-  out.put(history_);
-}
-
-void ImplicitStepper::load(ArchiveReader& in) {
-  in.get(dt_);
-  in.get(dt_try_);
-  in.get(counters_);
-  in.get(x_prev_);
-  in.get(x_prev2_);
-  in.get(w_prev_);
-  in.get(dt_prev2_);
-  in.get(history_);
-  near_x_.clear();  // the near list is derived: rebuilt at the next step
-}
-
 }  // namespace mrf

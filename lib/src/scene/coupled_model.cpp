@@ -451,9 +451,11 @@ void CoupledModel::inertialess_step() {
   fluid_.time = time_;
   ++steps_;
   fluid_.steps = steps_;
-  update_coupling_pairs();
+  // the DEM forces first: they wrap the positions into the box, from which
+  // the coupling pairs are then found (as after a checkpoint is loaded)
   sums_.dem = PairSums{};
   update_dem_forces();
+  update_coupling_pairs();
   tally();
 }
 

@@ -108,6 +108,7 @@ SphPairs find_pairs(const FluidCell& cell, double reach);
 // together more than the skin, every pair within 2h is a candidate, and its
 // separation now is r_ab(ref) + d_a - d_b with the displacements d since the
 // reference (minimum image: positions are wrapped in y and z each step).
+// The pairs come sorted by (a, b, image), whenever the cache was built.
 struct SphPairCache {
   double skin = 0;              // m; 0 = search every time
   SphPairs candidates;

@@ -114,8 +114,15 @@ class ImplicitStepper {
   double max_dt() const { return dt_max_; }  // s
 
   // The history (last steps, next try, counters); the near list is derived.
-  void save(ArchiveWriter& out) const;
-  void load(ArchiveReader& in);
+  template <class Archive, class Self>
+  static void serialize(Archive& ar, Self& s) {
+    ar.io(s.dt_, s.dt_try_, s.counters_, s.x_prev_, s.x_prev2_, s.w_prev_, s.dt_prev2_, s.history_);
+  }
+  void save(ArchiveWriter& out) const { serialize(out, *this); }
+  void load(ArchiveReader& in) {
+    serialize(in, *this);
+    near_x_.clear();  // rebuilt at the next step
+  }
 
  private:
   struct Attempt {

@@ -23,6 +23,13 @@ struct DemPairLists {
   std::size_t walls_ref = 0;    // number of wall particles at the last free-wall build
   double wall_travel = 0;       // largest wall displacement since the last free-wall build (m)
   long builds = 0;              // builds of either list
+  // Checkpoints: the lists as built (their reference positions decide the
+  // next rebuild, their order the round-off); the ranges and skin come from
+  // the scene. One field list for both directions (io/archive.hpp).
+  template <class Archive, class Self>
+  static void serialize(Archive& ar, Self& s) {
+    ar.io(s.ff.start, s.ff.k, s.fw, s.x_ref, s.x_ref_fw, s.walls_ref, s.wall_travel, s.builds);
+  }
 };
 
 // Largest displacement (m) of the points x from `ref` (minimum image).

@@ -48,6 +48,7 @@
 #include "mrf/integrate/implicit_stepper.hpp"
 #include "mrf/io/archive.hpp"
 #include "mrf/scene/dem_forces.hpp"
+#include "mrf/scene/dem_model.hpp"
 #include "mrf/scene/model.hpp"
 #include "mrf/scene/shear_cell.hpp"
 
@@ -142,10 +143,19 @@ class CoupledModel final : public Model {
   // the same scene; until the next step() the accessors of the last step's
   // coupling fields (coupling(), buoyancy(), ...) and sums() other than
   // wall_reflections and the porosity range are not restored.
-  void save(ArchiveWriter& out) const override;
+  void save(ArchiveWriter& out) const override { serialize(out, *this); }
   void load(ArchiveReader& in) override;
 
  private:
+  // What is and is not saved: scene/coupled_checkpoint.cpp.
+  template <class Archive, class Self>
+  static void serialize(Archive& ar, Self& m) {
+    serialize_dem_state(ar, m.cell_, m.lists_);
+    ar.io(m.fluid_.fluid.x, m.fluid_.fluid.v, m.fluid_.fluid.a_ext, m.fluid_.fluid.rest_density, m.fluid_.wall.x,
+          m.fluid_.wall.v, m.sums_.wall_reflections, m.external_impulse_, m.time_, m.steps_, m.eps_seen_min_,
+          m.eps_seen_max_, m.clamped_steps_);
+    if (m.implicit_) ar.io(*m.implicit_, m.fluid_substeps_, m.sph_pairs_.builds, m.viscous_iterations_);
+  }
   void update_coupling_pairs();
   void prepare_coupling(const std::vector<Vec3>& a_fluid);
   void update_dem_forces();

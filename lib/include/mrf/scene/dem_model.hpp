@@ -51,10 +51,16 @@ class DemModel final : public Model {
   // Checkpoint: the whole dynamic state (particles, walls, forces, pair
   // lists, clock), so that a restored model continues bit for bit
   // (scene/dem_checkpoint.cpp). load() expects a model built from the same scene.
-  void save(ArchiveWriter& out) const override;
+  void save(ArchiveWriter& out) const override { serialize(out, *this); }
   void load(ArchiveReader& in) override;
 
  private:
+  template <class Archive, class Self>
+  static void serialize(Archive& ar, Self& m) {
+    serialize_dem_state(ar, m.cell_, m.lists_);
+    ar.io(m.sums_, m.time_, m.steps_);
+    if (m.implicit_) ar.io(*m.implicit_);  // the step just taken, the next try, the work so far, the history
+  }
   void update_forces();
   void implicit_step();
   void check_finite_positions() const;  // before binning: the cell list needs finite coordinates
@@ -84,10 +90,13 @@ DemPairLists dem_pair_lists(const DemParams& p, const Box& box, bool implicit, b
 ImplicitContactParams implicit_contact_params(const DemParams& p, const Box& box);
 
 // The DEM part of a checkpoint, shared by DemModel and CoupledModel: free
-// particles (x, v, f), wall positions and the Verlet lists as built (their
-// reference positions decide the next rebuild, their order the round-off).
-// load_dem_state throws NumericalError when the particle counts differ.
-void save_dem_state(ArchiveWriter& out, const ShearCell& cell, const DemPairLists& lists);
-void load_dem_state(ArchiveReader& in, ShearCell& cell, DemPairLists& lists);
+// particles (x, v, f), wall positions and the Verlet lists as built; one
+// field list for both directions (io/archive.hpp).
+template <class Archive, class Cell, class Lists>
+void serialize_dem_state(Archive& ar, Cell& cell, Lists& lists) {
+  ar.io(cell.free.x, cell.free.v, cell.free.f, cell.walls.x, lists);
+}
+// After a load: NumericalError unless the particle counts are the scene's.
+void check_dem_state(const ShearCell& cell, std::size_t n_free, std::size_t n_wall);
 
 }  // namespace mrf
