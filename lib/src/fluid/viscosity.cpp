@@ -1,11 +1,10 @@
 #include "mrf/fluid/viscosity.hpp"
 
-#include <Eigen/IterativeLinearSolvers>
-#include <Eigen/SparseCore>
 #include <cmath>
 #include <sstream>
 
 #include "mrf/error.hpp"
+#include "mrf/integrate/pcg.hpp"
 
 namespace mrf {
 
@@ -51,46 +50,57 @@ void add_viscous_acceleration(const FluidCell& c, std::vector<Vec3>& a) {
 }
 
 ImplicitSolveStats solve_implicit_viscosity(const FluidCell& c, double dt, std::vector<Vec3>& v) {
-  const auto n = static_cast<Eigen::Index>(c.fluid.size());
+  // Matrix-free: the Morris weights of the fluid pairs once, then one PCG on
+  // the three velocity components together (the operator acts alike on
+  // each), for the correction to the predictor v, Jacobi-preconditioned.
+  const std::size_t n = c.fluid.size();
   const auto& rho = c.fluid.rho;
-  std::vector<Eigen::Triplet<double>> t;
-  t.reserve(2 * c.pairs.fluid_fluid.size() + c.fluid.size());
-  Eigen::VectorXd diag = Eigen::VectorXd::Ones(n);
-  Eigen::MatrixX3d rhs(n, 3);
-  for (Eigen::Index i = 0; i < n; ++i) rhs.row(i) = v[i].transpose();
-  for (const SphPair& pr : c.pairs.fluid_fluid) {
-    const double k = -dt * morris_weight(pr.r, c.h, c.mass, effective_viscosity(c), rho[pr.a], rho[pr.b]);
-    t.emplace_back(pr.a, pr.b, -k);
-    t.emplace_back(pr.b, pr.a, -k);
-    diag[pr.a] += k;
-    diag[pr.b] += k;
+  const auto& pairs = c.pairs.fluid_fluid;
+  std::vector<double> k(pairs.size()), diag(n, 1.0);
+  std::vector<Vec3> rhs(v);
+  for (std::size_t e = 0; e < pairs.size(); ++e) {
+    const SphPair& pr = pairs[e];
+    k[e] = -dt * morris_weight(pr.r, c.h, c.mass, effective_viscosity(c), rho[pr.a], rho[pr.b]);
+    diag[pr.a] += k[e];
+    diag[pr.b] += k[e];
   }
   for (const SphPair& pr : c.pairs.fluid_wall) {
-    const double k = -dt * wall_weight(c, pr);
-    diag[pr.a] += k;
-    rhs.row(pr.a) += k * c.wall.v[pr.b].transpose();
+    const double kw = -dt * wall_weight(c, pr);
+    diag[pr.a] += kw;
+    rhs[pr.a] += kw * c.wall.v[pr.b];
   }
-  for (Eigen::Index i = 0; i < n; ++i) t.emplace_back(i, i, diag[i]);
-  Eigen::SparseMatrix<double> m(n, n);
-  m.setFromTriplets(t.begin(), t.end());
-
-  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> cg;
-  cg.setTolerance(c.params.cg_tolerance);
-  cg.compute(m);
+  auto apply = [&](const std::vector<Vec3>& x, std::vector<Vec3>& out) {
+    out.resize(n);
+    for (std::size_t a = 0; a < n; ++a) out[a] = diag[a] * x[a];
+    for (std::size_t e = 0; e < pairs.size(); ++e) {
+      out[pairs[e].a] -= k[e] * x[pairs[e].b];
+      out[pairs[e].b] -= k[e] * x[pairs[e].a];
+    }
+  };
+  std::vector<Vec3> av, b(n), d;
+  apply(v, av);
+  for (std::size_t a = 0; a < n; ++a) b[a] = rhs[a] - av[a];
+  // stop where |residual| <= cg_tolerance |rhs|, as for a solve from zero
+  const double bn = std::sqrt(vector_dot(b, b)), rn = std::sqrt(vector_dot(rhs, rhs));
   ImplicitSolveStats stats;
-  for (int d = 0; d < 3; ++d) {
-    Eigen::VectorXd guess(n);
-    for (Eigen::Index i = 0; i < n; ++i) guess[i] = v[i][d];
-    const Eigen::VectorXd x = cg.solveWithGuess(rhs.col(d), guess);
-    if (cg.info() != Eigen::Success) {
+  if (bn > c.params.cg_tolerance * rn) {
+    PcgScratch<Vec3> cg;
+    const double rtol = c.params.cg_tolerance * rn / bn;
+    stats.iterations = static_cast<int>(pcg(
+        b, rtol, 10 * static_cast<long>(n) + 10, apply,
+        [&](const std::vector<Vec3>& r, std::vector<Vec3>& z) {
+          z.resize(n);
+          for (std::size_t a = 0; a < n; ++a) z[a] = r[a] / diag[a];
+        },
+        d, cg));
+    stats.residual = std::sqrt(vector_dot(cg.r, cg.r)) / rn;
+    if (!(stats.residual <= c.params.cg_tolerance)) {
       std::ostringstream s;
-      s << "SPH implicit viscosity: CG did not converge for velocity component " << d << " at step "
-        << c.steps << " (t = " << c.time << " s, dt = " << dt << " s, residual " << cg.error() << ")";
+      s << "SPH implicit viscosity: CG did not converge at step " << c.steps << " (t = " << c.time
+        << " s, dt = " << dt << " s, relative residual " << stats.residual << ")";
       throw NumericalError(s.str());
     }
-    for (Eigen::Index i = 0; i < n; ++i) v[i][d] = x[i];
-    stats.iterations = std::max(stats.iterations, static_cast<int>(cg.iterations()));
-    stats.residual = std::max(stats.residual, cg.error());
+    for (std::size_t a = 0; a < n; ++a) v[a] += d[a];
   }
   return stats;
 }

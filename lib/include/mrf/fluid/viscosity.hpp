@@ -59,8 +59,8 @@ void add_viscous_acceleration(const FluidCell& c, std::vector<Vec3>& a);
 Vec3 wall_viscous_acceleration(const FluidCell& c, const SphPair& pr);
 
 struct ImplicitSolveStats {
-  int iterations = 0;     // largest CG iteration count over the 3 components
-  double residual = 0;    // largest relative residual reached
+  int iterations = 0;     // CG iterations (the three components together)
+  double residual = 0;    // relative residual reached
 };
 
 // Backward Euler on the viscous term: solves
@@ -68,8 +68,10 @@ struct ImplicitSolveStats {
 // L the Morris operator among fluid particles (symmetric, K_ab = K_ba), with
 // the wall terms on the diagonal and in g (they keep the matrix symmetric
 // positive definite, so conjugate gradients with a Jacobi preconditioner
-// applies). `v` holds the predictor on entry, v_new on exit. Throws
-// NumericalError when CG does not reach params.cg_tolerance.
+// applies; matrix-free, the three components in one solve for the
+// correction to the predictor). `v` holds the predictor on entry, v_new on
+// exit. Throws NumericalError when the residual of all three components
+// together does not reach params.cg_tolerance of the right-hand side.
 ImplicitSolveStats solve_implicit_viscosity(const FluidCell& c, double dt, std::vector<Vec3>& v);
 
 }  // namespace mrf
