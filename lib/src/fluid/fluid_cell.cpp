@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "mrf/fluid/kernel.hpp"
+#include "mrf/forces/drag.hpp"
 #include "mrf/fluid/viscosity.hpp"
 #include "mrf/neighbors/cell_list.hpp"
 #include "mrf/neighbors/verlet_list.hpp"
@@ -57,7 +58,7 @@ void add_wall(FluidCell& cell, int side, int layers) {
 }  // namespace
 
 Vec3 wall_velocity(const FluidCell& cell, int side) {
-  return Vec3(0.0, 0.0, cell.params.shear_rate * side * 0.5 * cell.box.gap);
+  return mrf::wall_velocity(side, cell.params.shear_rate, cell.box.gap);
 }
 
 FluidCell build_fluid_cell(const Box& box, const FluidParams& params) {

@@ -1,5 +1,7 @@
 #include "mrf/fluid/wcsph.hpp"
 
+#include "mrf/forces/drag.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -152,7 +154,7 @@ ImplicitSolveStats step_implicit(FluidCell& c, double dt) {
 double viscous_limit(const FluidCell& c) { return 0.125 * c.h * c.h / c.params.kinematic_viscosity(); }
 
 std::vector<StabilityLimit> stability_limits(const FluidCell& c, bool implicit_viscosity) {
-  double vmax = std::abs(c.params.shear_rate) * 0.5 * c.box.gap;
+  double vmax = wall_speed(c.params.shear_rate, c.box.gap);
   for (const Vec3& v : c.fluid.v) vmax = std::max(vmax, v.norm());
   double fmax = 0.0;
   for (const Vec3& f : external_acceleration(c)) fmax = std::max(fmax, f.norm());

@@ -107,7 +107,7 @@ std::vector<StabilityLimit> dem_limits(const DemParams& p, double gap, Integrato
       out.push_back({"dipole stability", p.gamma * p.radius / p.contact_force,
                      "explicit dipoles, aligning mode of a chain: gamma R / F_contact"});
     if (p.shear_rate > 0)
-      out.push_back({"contact margin", 0.5 * k_contact_margin_over_radius * p.radius / (p.shear_rate * 0.5 * gap),
+      out.push_back({"contact margin", 0.5 * k_contact_margin_over_radius * p.radius / wall_speed(p.shear_rate, gap),
                      "walls move at most half the candidate margin (" + fmt(k_contact_margin_over_radius) +
                          " R) per step"});
     return out;
@@ -119,7 +119,7 @@ std::vector<StabilityLimit> dem_limits(const DemParams& p, double gap, Integrato
     out.push_back({"magnetic motion", k_frac * p.radius * p.gamma / (2.0 * p.contact_force),
                    "5 % of R per step at the contact force"});
   if (p.shear_rate > 0)
-    out.push_back({"shear (wall motion)", k_frac * p.radius / (p.shear_rate * 0.5 * gap),
+    out.push_back({"shear (wall motion)", k_frac * p.radius / wall_speed(p.shear_rate, gap),
                    "5 % of R per step at the wall speed"});
   return out;
 }

@@ -45,7 +45,7 @@ void overdamped_drift(std::vector<Vec3>& x, std::vector<Vec3>& v, const std::vec
 }
 
 void move_walls(WallParticles& walls, double shear_rate, double dt) {
-  for (auto& p : walls.x) p.z() += shear_rate * p.x() * dt;
+  for (auto& p : walls.x) p.z() += couette_velocity(p, shear_rate).z() * dt;  // each sphere on its wall plane
 }
 
 void wrap_all(std::vector<Vec3>& x, const Box& box) {

@@ -8,6 +8,7 @@
 
 #include "mrf/coupling/drag_laws.hpp"
 #include "mrf/error.hpp"
+#include "mrf/forces/drag.hpp"
 #include "mrf/scene/fluid_only.hpp"
 #include "mrf/fluid/fluid_observables.hpp"
 #include "mrf/fluid/kernel.hpp"
@@ -136,8 +137,8 @@ std::string CoupledModel::progress() const {
 
 void CoupledModel::finish(RunSummary& s) const {
   const Vec3 drift = momentum() - momentum0_ - external_impulse_;
-  const double scale = fluid_.mass * static_cast<double>(fluid_.fluid.size()) * std::abs(p_.shear_rate) * 0.5 *
-                       cell_.box.gap;  // the fluid's momentum at the wall speed
+  // the fluid's momentum at the wall speed
+  const double scale = fluid_.mass * static_cast<double>(fluid_.fluid.size()) * wall_speed(p_.shear_rate, cell_.box.gap);
   s.extra["porosity_min"] = eps_seen_min_;
   s.extra["porosity_max"] = eps_seen_max_;
   s.extra["steps_with_clamped_porosity"] = static_cast<double>(clamped_steps_);
@@ -281,7 +282,7 @@ void CoupledModel::dem_substep() {
   const Vec3 dem_old = sum_of(f.f);
   parcel_advance(f.x, f.v, f_old_, coupling_, parcel_, p_.mass, h);
   move_walls(cell_.walls, p_.shear_rate, h);
-  lists_.wall_travel += std::abs(p_.shear_rate) * 0.5 * cell_.box.gap * h;
+  lists_.wall_travel += wall_speed(p_.shear_rate, cell_.box.gap) * h;
   update_dem_forces();
   for (std::size_t i = 0; i < f.size(); ++i) f_new_[i] = f.f[i] + buoyancy_[i] + body_force_;
   parcel_correct(f.v, f_old_, f_new_, coupling_, parcel_, p_.mass, h);
@@ -420,7 +421,7 @@ void CoupledModel::inertialess_step() {
   }
   response_.add(f_nc, 1.0, drift_.w1);
   const double dt = implicit_->advance(drift_, f, cell_.walls, cell_.box, time_, steps_);
-  lists_.wall_travel += std::abs(p_.shear_rate) * 0.5 * cell_.box.gap * dt;
+  lists_.wall_travel += wall_speed(p_.shear_rate, cell_.box.gap) * dt;
   implicit_->contact_forces_end(f, cell_.walls, cell_.box, fc_end_);
   // What the fluid gave the particles (drag + buoyancy) is minus what they
   // pass on: -(F_c + F_nc + body) dt per particle.

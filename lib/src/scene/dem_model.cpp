@@ -6,6 +6,7 @@
 #include <string>
 
 #include "mrf/error.hpp"
+#include "mrf/forces/drag.hpp"
 #include "mrf/forces/hertz.hpp"
 #include "mrf/integrate/steps.hpp"
 #include "mrf/observe/stress.hpp"
@@ -35,7 +36,7 @@ DemPairLists dem_pair_lists(const DemParams& p, const Box& box, bool implicit, b
 }
 
 ImplicitContactParams implicit_contact_params(const DemParams& p, const Box& box) {
-  return {p.radius, p.hertz_k, p.shear_rate, std::abs(p.shear_rate) * 0.5 * box.gap};
+  return {p.radius, p.hertz_k, p.shear_rate, wall_speed(p.shear_rate, box.gap)};
 }
 
 DemModel::DemModel(ShearCell cell, const DemParams& params, IntegratorId scheme, double dt)
@@ -73,7 +74,7 @@ void DemModel::step() {
     overdamped_drift(f.x, f.v, f.f, p_.gamma, p_.shear_rate, dt_);
   }
   move_walls(cell_.walls, p_.shear_rate, dt_);
-  lists_.wall_travel += std::abs(p_.shear_rate) * 0.5 * cell_.box.gap * dt_;
+  lists_.wall_travel += wall_speed(p_.shear_rate, cell_.box.gap) * dt_;
   time_ += dt_;
   ++steps_;
   update_forces();
@@ -90,7 +91,7 @@ void DemModel::implicit_step() {
   for (std::size_t i = 0; i < f.size(); ++i)
     drift_.w0[i] = drift_velocity(f.x[i], f.f[i] - fc[i], 1.0 / p_.gamma, p_.shear_rate);
   const double dt = implicit_->advance(drift_, f, cell_.walls, cell_.box, time_, steps_);
-  lists_.wall_travel += std::abs(p_.shear_rate) * 0.5 * cell_.box.gap * dt;
+  lists_.wall_travel += wall_speed(p_.shear_rate, cell_.box.gap) * dt;
   time_ += dt;
   ++steps_;
   update_forces();
