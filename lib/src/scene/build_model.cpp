@@ -223,11 +223,39 @@ BuiltModel build_coupled(const LoadedScene& scene, ShearCell cell, const DemPara
   return b;
 }
 
+BuiltModel build_fluid_only(const LoadedScene& scene, bool quiet) {
+  const SceneConfig& c = scene.config;
+  const double t_end = c.strain / c.shear_rate;
+  FluidCell fluid = build_fluid_cell(Box{c.gap, c.ly, c.lz}, fluid_params_from_scene(c));
+  const FluidOnlyChoice ch = choose_fluid_only_step(c, fluid, t_end);
+  BuiltModel b;
+  RunSummary& s = b.summary;
+  s = scene_summary(c);
+  s.integrator = ch.implicit_viscosity ? "sph_implicit_viscosity" : "sph_explicit";
+  s.binding_limit = binding(ch.limits).name;
+  s.dt = ch.dt;
+  b.planned_steps = ch.steps;
+  s.steps = ch.steps;
+  s.n_fluid = static_cast<long>(fluid.fluid.size());
+  s.reynolds_number = reynolds_number(fluid.params, fluid.box);
+  s.extra = {{"sound_speed", fluid.c0}, {"n_fluid_wall", static_cast<double>(fluid.wall.size())}};
+  if (!quiet) {
+    std::fprintf(stderr, "mrf: fluid-only SPH shear cell, gdot = %.4g 1/s, %zu fluid particles\n", c.shear_rate,
+                 fluid.fluid.size());
+    print_table("fluid", ch.limits);
+    std::fprintf(stderr, "  chosen: %s, dt = %.4g s, %ld steps, Re = %.3g\n", s.integrator.c_str(), ch.dt, ch.steps,
+                 s.reynolds_number);
+  }
+  b.model = std::make_unique<FluidOnlyModel>(std::move(fluid), ch.implicit_viscosity, ch.dt);
+  return b;
+}
+
 }  // namespace
 
 BuiltModel build_model(const LoadedScene& scene, bool quiet) {
   const SceneConfig& c = scene.config;
   if (c.threads > 0) omp_set_num_threads(c.threads);
+  if (c.model != ModelId::dem_stokes && c.volume_fraction == 0) return build_fluid_only(scene, quiet);
   const DemParams p = dem_params(c);
   ShearCell cell = build_shear_cell(c, scene.locate("particles.volume_fraction"));
   for (std::size_t i = 0; i < cell.free.size(); ++i) cell.free.v[i] = couette_velocity(cell.free.x[i], c.shear_rate);

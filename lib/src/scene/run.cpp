@@ -3,60 +3,14 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
-
 #include "mrf/io/archive.hpp"
-#include "mrf/io/atomic_file.hpp"
 #include "mrf/scene/build_model.hpp"
-#include "mrf/scene/fluid_only.hpp"
 #include "mrf/scene/run_series.hpp"
 
 namespace mrf {
 
-// A fluid-only SPH shear cell (model demsph_*, no particles): start-up
-// Couette flow to the requested strain; the stress is the wall stress at the
-// end, with the start-up series beside it (no averaging window: one value).
-static RunSummary run_fluid_only(const LoadedScene& scene, const RunOptions& opt) {
-  const SceneConfig& c = scene.config;
-  const CouetteSphResult r = run_couette_sph(c, c.strain / c.shear_rate);
-  RunSummary s = scene_summary(c);
-  s.integrator = r.implicit_viscosity ? "sph_implicit_viscosity" : "sph_explicit";
-  s.dt = r.dt;
-  s.steps = r.steps;
-  s.n_fluid = static_cast<long>(r.n_fluid);
-  s.stress_total = {r.shear_stress, 0.0, 0.0};
-  s.stress_fluid = r.shear_stress;
-  s.reynolds_number = r.reynolds;
-  s.wall_seconds = r.wall_seconds;
-  s.extra = {{"stress_startup_series", r.analytic_stress},
-             {"stress_steady_eta_gdot", r.steady_stress},
-             {"profile_error_l2", r.profile_error},
-             {"max_density_deviation", r.max_density_deviation},
-             {"sound_speed", r.sound_speed},
-             {"n_fluid_wall", static_cast<double>(r.n_wall)}};
-  if (!opt.quiet) {
-    std::fprintf(stderr, "mrf: fluid-only SPH shear cell, gdot = %.4g 1/s, %zu fluid particles\n",
-                 c.shear_rate, r.n_fluid);
-    for (const auto& l : r.limits) std::fprintf(stderr, "  %-24s dt < %.3g\n", l.name.c_str(), l.dt);
-    std::fprintf(stderr, "  chosen: %s, dt = %.4g s, %lld steps, Re = %.3g\n", s.integrator.c_str(), r.dt,
-                 static_cast<long long>(r.steps), r.reynolds);
-  }
-  if (!opt.out_dir.empty()) {
-    std::filesystem::create_directories(opt.out_dir);
-    std::ofstream ts(opt.out_dir + "/timeseries.csv");
-    ts.precision(10);
-    ts << "time_s,strain,stress_total_Pa,stress_startup_series_Pa,profile_error_l2\n"
-       << r.time << "," << r.time * c.shear_rate << "," << r.shear_stress << "," << r.analytic_stress
-       << "," << r.profile_error << "\n";
-    write_file_atomic(opt.out_dir + "/summary.json", summary_json(s) + "\n");
-  }
-  return s;
-}
-
 RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
   const SceneConfig& c = scene.config;
-  if (c.model != ModelId::dem_stokes && c.volume_fraction == 0) return run_fluid_only(scene, opt);
   BuiltModel built = build_model(scene, opt.quiet);
   Model& model = *built.model;
   RunSummary s = std::move(built.summary);
@@ -107,9 +61,9 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
   }
   s.wall_seconds = st.elapsed_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   s.steps = n;
-  model.finish(s);
   if (!opt.quiet) std::fprintf(stderr, "\r  done: %ld steps in %.1f s%40s\n", n, s.wall_seconds, "");
   st.se.finish(s);
+  model.finish(s);  // after the series: a model may report its own stress (the fluid-only start-up)
   if (s.n_fluid > 0) s.extra["stress_fluid_err"] = st.se.fluid().err;
   s.extra["seconds_per_strain"] = s.wall_seconds / c.strain;
   s.max_overlap_over_radius = st.max_overlap / c.radius;

@@ -57,8 +57,9 @@ struct BuiltModel {
   long planned_steps;  // fixed steps to the end, or for adaptive steps the number at the largest step
 };
 
-// Builds the model of a scene with particles (a fluid-only scene is run by
-// run_couette_sph, scene/fluid_only.hpp). Prints the start-up table unless quiet.
+// Builds the model of a scene: DemModel (dem_stokes), CoupledModel
+// (demsph_* with particles) or FluidOnlyModel (demsph_* without,
+// scene/fluid_only.hpp). Prints the start-up table unless quiet.
 BuiltModel build_model(const LoadedScene& scene, bool quiet = true);
 
 }  // namespace mrf

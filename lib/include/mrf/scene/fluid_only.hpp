@@ -1,6 +1,7 @@
 // Fluid-only start-up Couette run of the SPH carrier in the shear cell, from
-// a scene (model demsph_*, volume_fraction = 0): the entry point for
-// `mrf run` and the end-to-end check of the fluid solver.
+// a scene (model demsph_*, volume_fraction = 0): the third Model that
+// `mrf run` builds (build_model) and the end-to-end check of the fluid
+// solver.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -8,6 +9,7 @@
 #include "mrf/fluid/fluid_cell.hpp"
 #include "mrf/fluid/wcsph.hpp"
 #include "mrf/scene/config.hpp"
+#include "mrf/scene/model.hpp"
 
 namespace mrf {
 
@@ -32,6 +34,52 @@ struct CouetteSphResult {
   double wall_seconds = 0;
   std::size_t n_fluid = 0, n_wall = 0;
 };
+
+// The SPH shear cell from rest, fixed steps: explicit, or the viscosity by
+// backward Euler. Its stress is the wall stress of the fluid; finish()
+// reports the value at the end (a start-up transient has no steady window)
+// beside the start-up series of REFERENCE §5 at that time.
+class FluidOnlyModel final : public Model {
+ public:
+  FluidOnlyModel(FluidCell cell, bool implicit_viscosity, double dt);
+  void step() override;
+  double time() const override { return fluid_.time; }
+  double dt() const override { return dt_; }
+  long steps() const override { return static_cast<long>(fluid_.steps); }
+  bool adaptive() const override { return false; }
+  void set_stop_time(double) override {}
+  StepSample sample() const override;
+  const ShearCell& cell() const override { return no_particles_; }
+  const DemPairLists& lists() const override { return no_lists_; }
+  void save(ArchiveWriter& out) const override { serialize(out, *this); }
+  void load(ArchiveReader& in) override;
+  void finish(RunSummary& s) const override;
+  const FluidCell& fluid() const { return fluid_; }
+  double max_density_deviation() const { return max_density_deviation_; }
+
+ private:
+  template <class Archive, class Self>
+  static void serialize(Archive& ar, Self& m) {
+    ar.io(m.fluid_.fluid.x, m.fluid_.fluid.v, m.fluid_.wall.x, m.fluid_.time, m.fluid_.steps,
+          m.max_density_deviation_);
+  }
+  FluidCell fluid_;
+  bool implicit_;
+  double dt_;
+  double stress_ = 0, max_density_deviation_ = 0;
+  ShearCell no_particles_;
+  DemPairLists no_lists_;
+  PairSums no_pairs_;
+};
+
+// The fluid-only model of a scene, its step chosen from the SPH limits.
+struct FluidOnlyChoice {
+  bool implicit_viscosity;
+  double dt;                           // s, landing on t_end
+  long steps;
+  std::vector<StabilityLimit> limits;  // of the scheme used, at start
+};
+FluidOnlyChoice choose_fluid_only_step(const SceneConfig& cfg, const FluidCell& cell, double t_end);
 
 // Runs from rest for `t_end` seconds. Viscosity is implicit for integrator
 // "implicit", and for "auto" when the viscous limit is the binding one;
