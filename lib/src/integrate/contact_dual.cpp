@@ -20,70 +20,21 @@ Vec3 pair_vector(const ContactPair& c, const std::vector<Vec3>& x, const WallPar
 void ContactDual::move(const std::vector<ContactPair>& pairs, const std::vector<double>& q, bool active_only,
                        std::vector<Vec3>& y, bool contact_rows_only) {
   const std::vector<double>& mob = *mob_;
+  const std::size_t m = active_only ? act_.size() : pairs.size();
   if (coupled_) s_.assign(y.size(), Vec3::Zero());
-  if (active_only) {
-    // The spheres of active contacts gather their pairs (incidence lists in
-    // pair order): no two threads write one sphere and every sum has a fixed
-    // order, so the result does not depend on the thread count.
-    const std::size_t m = act_particles_.size();
-    const bool threads = act_inc_.size() > k_entries_per_thread;
-#pragma omp parallel for schedule(static) if (threads)
-    for (std::size_t r = 0; r < m; ++r) {
-      Vec3 f = Vec3::Zero();
-      for (std::uint32_t e = act_inc_start_[r]; e < act_inc_start_[r + 1]; ++e) {
-        const std::uint32_t a = act_inc_[e] >> 1;
-        const Vec3 g = q[a] * n_[act_[a]];
-        if (act_inc_[e] & 1u)
-          f -= g;
-        else
-          f += g;
-      }
-      const std::uint32_t i = act_particles_[r];
-      y[i] += mob[i] * f;
-      if (coupled_) s_[i] = f;
-    }
-  } else {  // all candidates, twice per Newton iteration: a plain pass
-    for (std::size_t c = 0; c < pairs.size(); ++c) {
-      if (q[c] == 0) continue;
-      const ContactPair& pc = pairs[c];
-      const Vec3 f = q[c] * n_[c];
-      y[pc.i] += mob[pc.i] * f;
-      if (!pc.wall) y[pc.k] -= mob[pc.k] * f;
-      if (coupled_) {
-        s_[pc.i] += f;
-        if (!pc.wall) s_[pc.k] -= f;
-      }
+  for (std::size_t a = 0; a < m; ++a) {
+    const std::size_t c = active_only ? act_[a] : a;
+    if (q[a] == 0) continue;
+    const ContactPair& pc = pairs[c];
+    const Vec3 f = q[a] * n_[c];
+    y[pc.i] += mob[pc.i] * f;
+    if (!pc.wall) y[pc.k] -= mob[pc.k] * f;
+    if (coupled_) {
+      s_[pc.i] += f;
+      if (!pc.wall) s_[pc.k] -= f;
     }
   }
   if (coupled_) coupled_->add(s_, coupled_scale_, y, contact_rows_only ? &act_particles_ : nullptr);
-}
-
-// The spheres of the active pairs, sorted, and for each the active pairs it
-// belongs to (place in act_ << 1, | 1 where it is k).
-void ContactDual::index_active(const std::vector<ContactPair>& pairs, std::size_t n) {
-  slot_.assign(n, -1);
-  act_particles_.clear();
-  for (auto c : act_) {
-    act_particles_.push_back(pairs[c].i);
-    if (!pairs[c].wall) act_particles_.push_back(pairs[c].k);
-  }
-  std::sort(act_particles_.begin(), act_particles_.end());
-  act_particles_.erase(std::unique(act_particles_.begin(), act_particles_.end()), act_particles_.end());
-  for (std::size_t r = 0; r < act_particles_.size(); ++r) slot_[act_particles_[r]] = static_cast<std::int32_t>(r);
-  const std::size_t m = act_particles_.size();
-  act_inc_start_.assign(m + 1, 0);
-  for (auto c : act_) {
-    ++act_inc_start_[static_cast<std::size_t>(slot_[pairs[c].i]) + 1];
-    if (!pairs[c].wall) ++act_inc_start_[static_cast<std::size_t>(slot_[pairs[c].k]) + 1];
-  }
-  for (std::size_t r = 0; r < m; ++r) act_inc_start_[r + 1] += act_inc_start_[r];
-  act_inc_.resize(act_inc_start_[m]);
-  fill_.assign(act_inc_start_.begin(), act_inc_start_.end() - 1);
-  for (std::uint32_t a = 0; a < act_.size(); ++a) {
-    const ContactPair& c = pairs[act_[a]];
-    act_inc_[fill_[static_cast<std::size_t>(slot_[c.i])]++] = a << 1;
-    if (!c.wall) act_inc_[fill_[static_cast<std::size_t>(slot_[c.k])]++] = (a << 1) | 1u;
-  }
 }
 
 void ContactDual::add_forces(const std::vector<ContactPair>& pairs, std::vector<Vec3>& f) const {
@@ -95,22 +46,31 @@ void ContactDual::add_forces(const std::vector<ContactPair>& pairs, std::vector<
   }
 }
 
-// (A + C) p on the active set: A = G^T M G, C diagonal; with a coupled
-// mobility M = diag(mob) + s C, of whose product only the spheres of active
-// contacts are read back.
+// (A + C) p on the active set: A = G^T M G, C diagonal. With a coupled
+// mobility M = diag(mob) + s C moves every particle that shares fluid with
+// an active contact, so the product goes through move(); without, only the
+// particles of active contacts move.
 void ContactDual::apply(const std::vector<ContactPair>& pairs, const std::vector<double>& p,
                         std::vector<double>& out) {
+  const std::vector<double>& mob = *mob_;
   if (coupled_) {
     std::fill(disp_.begin(), disp_.end(), Vec3::Zero());
+    move(pairs, p, true, disp_, true);  // only the spheres of active contacts are read back
   } else {
-    for (std::uint32_t i : act_particles_) disp_[i].setZero();
+    for (std::size_t a = 0; a < act_.size(); ++a) {
+      const ContactPair& c = pairs[act_[a]];
+      disp_[c.i].setZero();
+      if (!c.wall) disp_[c.k].setZero();
+    }
+    for (std::size_t a = 0; a < act_.size(); ++a) {
+      const ContactPair& c = pairs[act_[a]];
+      const Vec3 g = p[a] * n_[act_[a]];
+      disp_[c.i] += mob[c.i] * g;
+      if (!c.wall) disp_[c.k] -= mob[c.k] * g;
+    }
   }
-  move(pairs, p, true, disp_, true);
-  const std::size_t m = act_.size();
-  out.resize(m);
-  const bool threads = act_inc_.size() > k_entries_per_thread;
-#pragma omp parallel for schedule(static) if (threads)
-  for (std::size_t a = 0; a < m; ++a) {
+  out.resize(act_.size());
+  for (std::size_t a = 0; a < act_.size(); ++a) {
     const std::uint32_t e = act_[a];
     const ContactPair& c = pairs[e];
     const Vec3 rel = c.wall ? disp_[c.i] : Vec3(disp_[c.i] - disp_[c.k]);
@@ -155,7 +115,7 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
   comp_.resize(np);
   rhs_.resize(np);
   s_.resize(y.size());
-  disp_.assign(y.size(), Vec3::Zero());
+  disp_.resize(y.size());
   if (coupled_) {  // s (C_ii + C_kk - 2 C_ik) of each candidate: the diagonal of s G^T C G (Jacobi)
     crel_.resize(np);
     for (std::size_t c = 0; c < np; ++c) {
@@ -178,31 +138,30 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
   NewtonResult res;
   for (res.iterations = 1; res.iterations <= opt.max_iterations; ++res.iterations) {
     // Residuals at y, normals updated to y; y_next = b + M G(y) lambda.
-    // Pair by pair on threads; the active set is then gathered in pair order.
-    const bool threads = np > k_entries_per_thread;
-    active_.resize(np);
-#pragma omp parallel for schedule(static) if (threads)
+    act_.clear();
+    double worst = 0;
     for (std::size_t c = 0; c < np; ++c) {
       const ContactPair& pc = pairs[c];
       const Vec3 r = pair_vector(pc, y, walls, mi);
       const double rn = r.norm(), h = two_r - rn;
       n_[c] = r / rn;
-      active_[c] = !(lambda_[c] <= 0 && h <= 0);  // not open and staying open
-      if (!active_[c]) continue;
+      if (lambda_[c] <= 0 && h <= 0) continue;  // open and staying open
       const double h_lambda = std::cbrt(lambda_[c] * lambda_[c]) / k23;  // (lambda/k)^{2/3}
-      rhs_[c] = h - h_lambda;  // the Hertz law's residual as an overlap
+      const double phi = h - h_lambda;  // the Hertz law's residual as an overlap
+      rhs_[c] = phi;
       // Compliance slope: of the current force, or for a contact closing
       // from zero force, of the Hertz law at the overlap y gives it.
       comp_[c] = lambda_[c] > 0 ? 2.0 * h_lambda / (3.0 * lambda_[c]) : 1.0 / hertz_local_stiffness(h, hertz_k);
-    }
-    act_.clear();
-    double worst = 0;
-    for (std::size_t c = 0; c < np; ++c) {
-      if (!active_[c]) continue;
       act_.push_back(static_cast<std::uint32_t>(c));
-      if (std::abs(rhs_[c]) > worst) worst = std::abs(rhs_[c]), res.worst = pairs[c].i;
+      if (std::abs(phi) > worst) worst = std::abs(phi), res.worst = pc.i;
     }
-    index_active(pairs, y.size());
+    act_particles_.clear();
+    for (auto c : act_) {
+      act_particles_.push_back(pairs[c].i);
+      if (!pairs[c].wall) act_particles_.push_back(pairs[c].k);
+    }
+    std::sort(act_particles_.begin(), act_particles_.end());
+    act_particles_.erase(std::unique(act_particles_.begin(), act_particles_.end()), act_particles_.end());
     y_next_ = b;
     move(pairs, lambda_, false, y_next_);
     // y was placed with the normals of the last iterate; with the normals

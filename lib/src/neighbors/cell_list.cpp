@@ -1,7 +1,5 @@
 #include "mrf/neighbors/cell_list.hpp"
 
-#include <omp.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -88,36 +86,13 @@ void self_pair_rows(const std::vector<Vec3>& pts, const Box& box, double cutoff,
   grid.bin(pts);
   const double rc2 = cutoff * cutoff;
   const MinImageYZ mi(box);
-  // Rows in contiguous blocks, one per thread, joined in block order: the
-  // list is the serial one whatever the thread count.
-  constexpr std::size_t k_rows_per_thread = 1000;
-  const std::size_t n = pts.size();
-  const int nt = static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(omp_get_max_threads()),
-                                                        std::max<std::size_t>(1, n / k_rows_per_thread)));
-  std::vector<std::vector<std::uint32_t>> part(static_cast<std::size_t>(nt));
-#pragma omp parallel num_threads(nt)
-  {
-    const int t = omp_get_thread_num();
-    const std::size_t begin = n * static_cast<std::size_t>(t) / static_cast<std::size_t>(nt);
-    const std::size_t end = n * static_cast<std::size_t>(t + 1) / static_cast<std::size_t>(nt);
-    std::vector<std::uint32_t>& k = part[static_cast<std::size_t>(t)];
-    for (std::size_t i = begin; i < end; ++i) {
-      const Vec3 xi = pts[i];
-      grid.for_each_candidate(xi, [&](std::uint32_t j) {
-        if (j <= i) return;
-        if (mi.norm2(xi, pts[j]) < rc2) k.push_back(j);
-      });
-      out.start[i + 1] = static_cast<std::uint32_t>(k.size());  // within the block, shifted below
-    }
-  }
-  std::size_t offset = 0;
-  for (int t = 0; t < nt; ++t) {
-    const std::size_t begin = n * static_cast<std::size_t>(t) / static_cast<std::size_t>(nt);
-    const std::size_t end = n * static_cast<std::size_t>(t + 1) / static_cast<std::size_t>(nt);
-    for (std::size_t i = begin; i < end; ++i) out.start[i + 1] += static_cast<std::uint32_t>(offset);
-    const auto& k = part[static_cast<std::size_t>(t)];
-    out.k.insert(out.k.end(), k.begin(), k.end());
-    offset += k.size();
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const Vec3 xi = pts[i];
+    grid.for_each_candidate(xi, [&](std::uint32_t j) {
+      if (j <= i) return;
+      if (mi.norm2(xi, pts[j]) < rc2) out.k.push_back(j);
+    });
+    out.start[i + 1] = static_cast<std::uint32_t>(out.k.size());
   }
 }
 

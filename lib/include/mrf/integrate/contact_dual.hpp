@@ -52,7 +52,6 @@ class ContactDual {
   // coupled part for every sphere, or only those of active contacts
   void move(const std::vector<ContactPair>& pairs, const std::vector<double>& q, bool active_only,
             std::vector<Vec3>& y, bool contact_rows_only = false);
-  void index_active(const std::vector<ContactPair>& pairs, std::size_t n);
   // (A + C) p on the active set
   void apply(const std::vector<ContactPair>& pairs, const std::vector<double>& p, std::vector<double>& out);
   long solve_cg(const std::vector<ContactPair>& pairs, double rtol);
@@ -62,12 +61,6 @@ class ContactDual {
   std::vector<double> lambda_, comp_, rhs_, crel_;
   std::vector<Vec3> n_;
   std::vector<std::uint32_t> act_;           // active pairs
-  std::vector<char> active_;                 // per pair: active in this Newton iteration
-  // Per sphere of an active pair (act_particles_), the active pairs it
-  // belongs to: the products gather them, so they run on threads.
-  std::vector<std::uint32_t> act_inc_start_, act_inc_, fill_;
-  std::vector<std::int32_t> slot_;  // sphere -> place in act_particles_, or -1
-  static constexpr std::size_t k_entries_per_thread = 4096;
   std::vector<std::uint32_t> act_particles_;  // the spheres of active pairs, sorted
   std::vector<double> d_, r_, diag_, dq_;           // CG on the active set: solution, right-hand side, Jacobi diagonal
   PcgScratch<double> cg_;
