@@ -142,6 +142,34 @@ TEST(SceneInput, ZeroMagnetizationWithShearRateGivesAnInfiniteMasonNumber) {
   }
 }
 
+// drive.vary = "magnetization": the Mason number at a fixed shear rate,
+// M = sqrt(9 eta gdot / (2 mu0 Mn)) replacing the file's magnetisation
+// (REFERENCE §8); the shear rate is needed, and the default still takes
+// drive.mason at the given M.
+TEST(SceneInput, MagnetizationFollowsTheMasonNumberAtAFixedShearRate) {
+  const double eta = 0.1;
+  for (const double mn : {1e-3, 3e-2, 1.0}) {
+    const LoadedScene s = parse_scene(k_scene, "scene.toml",
+                                      {"drive.vary=\"magnetization\"", "drive.shear_rate=1e3",
+                                       "drive.mason=" + std::to_string(mn)});
+    EXPECT_EQ(s.config.vary, MasonBy::magnetization);
+    EXPECT_DOUBLE_EQ(s.config.shear_rate, 1e3);
+    EXPECT_DOUBLE_EQ(s.config.mason, mn);
+    EXPECT_NEAR(s.config.magnetization, std::sqrt(9 * eta * 1e3 / (2 * k_mu0 * mn)), 1e-9 * s.config.magnetization);
+    EXPECT_NEAR(9 * eta * s.config.shear_rate / (2 * k_mu0 * std::pow(s.config.magnetization, 2)), mn, 1e-12 * mn);
+  }
+  EXPECT_NEAR(parse_scene(k_scene, "s", {"drive.vary=\"magnetization\"", "drive.shear_rate=1e3", "drive.mason=1e-3"})
+                  .config.magnetization,
+              6.0e5, 0.01 * 6.0e5);  // REFERENCE §8: Mn = 1e-3 at 1e3 1/s is M = 6.0e5 A/m
+  try {
+    parse_scene(k_scene, "s", {"drive.vary=\"magnetization\""});  // the file gives drive.mason only
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), "drive.shear_rate") << e.what();
+  }
+  EXPECT_EQ(parse_scene(k_scene, "s").config.vary, MasonBy::shear_rate);
+}
+
 TEST(SceneInput, OptionalKeysTakeTheirDefaults) {
   const std::string text = edit(edit(k_scene.substr(0, k_scene.find("[numerics]")), "model =",
                                      "model = \"demsph_dd\""),

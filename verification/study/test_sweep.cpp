@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include <bit>
 #include <cstdint>
 #include <cstdlib>
@@ -31,6 +33,23 @@ std::string grid_text(const std::string& extra = "") {
          "seeds = [1, 2]\n"
          "set = [\"drive.strain=4\"]\n" +
          extra;
+}
+
+// The realistic path (REFERENCE §8): the sweep holds the shear rate and the
+// Mason number of each point sets the magnetisation.
+TEST(Sweep, MasonNumberByMagnetizationAtAFixedShearRate) {
+  const SweepSpec s = parse_sweep("[sweep]\nscene = \"small_dem_stokes.toml\"\nmodels = [\"dem_stokes\"]\n"
+                                  "mason = [1e-3, 0.01, 1.0]\nseeds = [1]\n"
+                                  "set = [\"drive.vary='magnetization'\", \"drive.shear_rate=1e3\"]\n",
+                                  "grid.toml", k_scenes);
+  double last_m = std::numeric_limits<double>::infinity();
+  for (const SweepPoint& p : sweep_points(s)) {
+    const LoadedScene scene = load_scene(s.scene_path, p.sets);
+    EXPECT_DOUBLE_EQ(scene.config.shear_rate, 1e3);
+    EXPECT_DOUBLE_EQ(scene.config.mason, p.mason);
+    EXPECT_LT(scene.config.magnetization, last_m);  // weaker fields reach higher Mn
+    last_m = scene.config.magnetization;
+  }
 }
 
 TEST(Sweep, GridIsModelMajorWithOverridesInOrder) {

@@ -62,7 +62,7 @@ E read_choice(const Value& val, const E (&all)[N]) {
 enum class Need { required, optional, sph_models, one_of_drive };
 
 using Target = std::variant<double SceneConfig::*, int SceneConfig::*, std::uint64_t SceneConfig::*,
-                            ModelId SceneConfig::*, IntegratorId SceneConfig::*,
+                            ModelId SceneConfig::*, IntegratorId SceneConfig::*, MasonBy SceneConfig::*,
                             std::optional<double> SceneConfig::*>;
 
 struct KeySpec {
@@ -93,6 +93,7 @@ const KeySpec k_keys[] = {
     {"fluid.density", &C::fluid_density, Dim::density, Need::required, k_pos},
     {"fluid.sph_spacing", &C::sph_spacing, Dim::length, Need::sph_models, k_pos},
     {"fluid.sound_speed", &C::sound_speed, Dim::velocity, Need::optional, k_nonneg},
+    {"drive.vary", &C::vary, Dim::none, Need::optional, k_any},
     {"drive.mason", &C::mason, Dim::none, Need::one_of_drive, k_pos},
     {"drive.shear_rate", &C::shear_rate, Dim::rate, Need::one_of_drive, k_pos},
     {"drive.strain", &C::strain, Dim::none, Need::required, k_pos},
@@ -109,6 +110,7 @@ const KeySpec k_keys[] = {
 };
 
 constexpr ModelId k_models[] = {ModelId::dem_stokes, ModelId::demsph_stokes, ModelId::demsph_dd};
+constexpr MasonBy k_vary[] = {MasonBy::shear_rate, MasonBy::magnetization};
 constexpr IntegratorId k_integrators[] = {IntegratorId::automatic, IntegratorId::verlet_exp,
                                           IntegratorId::overdamped, IntegratorId::implicit};
 
@@ -124,6 +126,7 @@ void assign(SceneConfig& c, const KeySpec& spec, const Value& val) {
                  [&](std::uint64_t C::*m) { c.*m = read_count<std::uint64_t>(val); },
                  [&](ModelId C::*m) { c.*m = read_choice(val, k_models); },
                  [&](IntegratorId C::*m) { c.*m = read_choice(val, k_integrators); },
+                 [&](MasonBy C::*m) { c.*m = read_choice(val, k_vary); },
                  [&](std::optional<double> C::*m) {  // "auto" or a number
                    const auto* s = std::get_if<std::string>(&val.v);
                    if (s && trim(*s) == "auto") c.*m = std::nullopt;
@@ -297,8 +300,13 @@ void apply_override(Given& given, const std::string& text) {
   const std::string key(trim(std::string_view(text).substr(0, eq)));
   const std::string raw(trim(std::string_view(text).substr(eq + 1)));
   if (!find_spec(key)) throw InputError(key, raw, where, unknown_why(key, false, false));
-  // drive.mason and drive.shear_rate are alternatives: an override replaces the file's choice.
-  const char* other = key == "drive.mason" ? "drive.shear_rate"
+  // drive.mason and drive.shear_rate are alternatives: an override replaces
+  // the file's choice, unless the magnetisation is to follow from both.
+  const auto vary = given.find("drive.vary");
+  const auto* by = vary == given.end() ? nullptr : std::get_if<std::string>(&vary->second.v);
+  const bool both = by && *by == "magnetization";
+  const char* other = both ? nullptr
+                      : key == "drive.mason" ? "drive.shear_rate"
                       : key == "drive.shear_rate" ? "drive.mason" : nullptr;
   const auto clash = other ? given.find(other) : given.end();
   if (clash != given.end() && !clash->second.where.starts_with("--set")) given.erase(clash);
@@ -333,6 +341,14 @@ void require_keys(const LoadedScene& s, const Given& given) {
   }
   const auto mason = given.find("drive.mason");
   const bool rate = given.count("drive.shear_rate") > 0;
+  if (s.config.vary == MasonBy::magnetization) {  // Mn at a fixed shear rate: both needed
+    for (const char* key : {"drive.mason", "drive.shear_rate"})
+      if (!given.count(key))
+        throw InputError(key, "", s.locate("drive.vary"),
+                         "missing key (drive.vary = \"magnetization\" sets the magnetisation from drive.mason "
+                         "and drive.shear_rate: give both)");
+    return;
+  }
   if (mason == given.end() && !rate)
     throw InputError("drive.mason", "", s.source,
                      "missing key (give drive.mason or drive.shear_rate)");
@@ -373,7 +389,7 @@ const Rule k_rules[] = {
                      " = " + num(phi_eff(c)) + " (limit " + num(k_max_packing) + ")");
      }},
     {"particles.magnetization", [](const C& c, const Given& g) {
-       return unless(c.magnetization > 0 || !g.count("drive.mason"),
+       return unless(c.magnetization > 0 || !g.count("drive.mason") || c.vary == MasonBy::magnetization,
                      "must be > 0 when drive.mason is given (at M = 0, Mn = 9 eta gdot / (2 mu0 M^2) fixes no "
                      "shear rate; give drive.shear_rate for non-magnetic particles)");
      }},
@@ -410,6 +426,10 @@ void validate(const LoadedScene& s, const Given& given) {
 }
 
 void fill_drive(C& c, const Given& given) {
+  if (c.vary == MasonBy::magnetization) {
+    c.magnetization = magnetization_from_mason(c.mason, c.viscosity, c.shear_rate);
+    return;
+  }
   if (given.count("drive.mason"))
     c.shear_rate = shear_rate_from_mason(c.mason, c.viscosity, c.magnetization);
   else  // M = 0 (allowed with shear_rate): Mn is infinite, stated rather than left to a division by zero

@@ -1,5 +1,7 @@
 #include "mrf/scene/config.hpp"
 
+#include <cmath>
+
 #include "mrf/vec.hpp"
 
 namespace mrf {
@@ -30,5 +32,11 @@ double mason_from_shear_rate(double shear_rate, double viscosity, double magneti
 double shear_rate_from_mason(double mason, double viscosity, double magnetization) {
   return mason * 2.0 * k_mu0 * magnetization * magnetization / (9.0 * viscosity);
 }
+
+double magnetization_from_mason(double mason, double viscosity, double shear_rate) {
+  return std::sqrt(9.0 * viscosity * shear_rate / (2.0 * k_mu0 * mason));
+}
+
+const char* to_string(MasonBy v) { return v == MasonBy::shear_rate ? "shear_rate" : "magnetization"; }
 
 }  // namespace mrf

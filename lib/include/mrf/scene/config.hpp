@@ -11,8 +11,13 @@
 namespace mrf {
 
 enum class ModelId { dem_stokes, demsph_stokes, demsph_dd };
+// What sets the Mason number (REFERENCE §8, "How the Mason number is
+// varied"): the shear rate at the given magnetisation, or the magnetisation
+// at the given shear rate, M = sqrt(9 eta gdot / (2 mu0 Mn)).
+enum class MasonBy { shear_rate, magnetization };
 
 const char* to_string(ModelId m);
+const char* to_string(MasonBy v);
 
 struct SceneConfig {
   // [scene]
@@ -39,7 +44,10 @@ struct SceneConfig {
   // [drive]: exactly one of mason, shear_rate is given in the file; both are
   // filled in after validation (Mn = 9 eta gdot / (2 mu0 M^2), DESIGN.md).
   // Mn = +inf for drive.shear_rate with magnetization = 0 (no magnetic
-  // forces); drive.mason with magnetization = 0 is refused.
+  // forces); drive.mason with magnetization = 0 is refused. With
+  // vary = "magnetization" both are given and particles.magnetization is
+  // derived from them (a value in the file is replaced).
+  MasonBy vary = MasonBy::shear_rate;
   double mason = 0;
   double shear_rate = 0;       // 1/s
   double strain = 0;           // total strain of the run
@@ -60,5 +68,6 @@ struct SceneConfig {
 // Mason number from shear rate and back (DESIGN.md convention).
 double mason_from_shear_rate(double shear_rate, double viscosity, double magnetization);
 double shear_rate_from_mason(double mason, double viscosity, double magnetization);
+double magnetization_from_mason(double mason, double viscosity, double shear_rate);
 
 }  // namespace mrf
