@@ -1,46 +1,43 @@
 #include "mrf/coupling/fluid_response.hpp"
 
 #include <algorithm>
-#include <numeric>
 
 namespace mrf {
 
 void FluidResponse::set(std::size_t n_dem, const std::vector<CouplingPair>& pairs, const std::vector<double>& s,
                         const std::vector<double>& rho, double mass) {
-  // Per DEM particle its SPH neighbours sorted by index, the periodic images
-  // of one neighbour merged (their weights add): C_ik is then a merge of two
-  // short sorted lists.
-  start_.assign(n_dem + 1, 0);
-  for (const CouplingPair& q : pairs) ++start_[q.i + 1];
-  for (std::size_t i = 0; i < n_dem; ++i) start_[i + 1] += start_[i];
-  order_.resize(pairs.size());
-  std::iota(order_.begin(), order_.end(), 0u);
+  // Per DEM particle its SPH neighbours in the order of the pairs (pairs
+  // come sorted by DEM index), the periodic images of one neighbour merged
+  // (their weights add; slot_ finds an SPH particle's entry of the row).
+  const std::size_t na = rho.size();
+  slot_.assign(na, -1);
   a_.clear();
   scatter_.clear();
   gather_.clear();
   std::vector<std::uint32_t> merged(n_dem + 1, 0);
+  std::size_t next = 0;
   for (std::size_t i = 0; i < n_dem; ++i) {
-    const auto b = order_.begin() + start_[i], e = order_.begin() + start_[i + 1];
-    std::sort(b, e, [&](std::uint32_t x, std::uint32_t y) { return pairs[x].a < pairs[y].a; });
-    for (auto it = b; it != e; ++it) {
-      const CouplingPair& q = pairs[*it];
+    const std::size_t row = a_.size();
+    for (; next < pairs.size() && pairs[next].i == i; ++next) {
+      const CouplingPair& q = pairs[next];
       const double sc = q.w / (rho[q.a] * s[i]);
-      if (!a_.empty() && a_.size() > merged[i] && a_.back() == q.a) {
-        scatter_.back() += sc;
-        gather_.back() += mass * sc;
+      if (slot_[q.a] >= 0) {
+        scatter_[static_cast<std::size_t>(slot_[q.a])] += sc;
+        gather_[static_cast<std::size_t>(slot_[q.a])] += mass * sc;
       } else {
+        slot_[q.a] = static_cast<std::int32_t>(a_.size());
         a_.push_back(q.a);
         scatter_.push_back(sc);
         gather_.push_back(mass * sc);
       }
     }
+    for (std::size_t k = row; k < a_.size(); ++k) slot_[a_[k]] = -1;
     merged[i + 1] = static_cast<std::uint32_t>(a_.size());
   }
   start_ = std::move(merged);
   // The same entries by SPH particle (CSR over a), so that the scatter is a
   // gather too: both passes run on threads without write conflicts, each
   // sum in a fixed order.
-  const std::size_t na = rho.size();
   rstart_.assign(na + 1, 0);
   for (std::uint32_t b : a_) ++rstart_[b + 1];
   for (std::size_t b = 0; b < na; ++b) rstart_[b + 1] += rstart_[b];
@@ -56,22 +53,16 @@ void FluidResponse::set(std::size_t n_dem, const std::vector<CouplingPair>& pair
   diag_.assign(n_dem, 0.0);
   for (std::size_t i = 0; i < n_dem; ++i)
     for (std::uint32_t e = start_[i]; e < start_[i + 1]; ++e) diag_[i] += gather_[e] * scatter_[e];
-  z_.assign(3 * rho.size(), 0.0);
+  z_.assign(3 * na, 0.0);
+  dense_.assign(na, 0.0);
 }
 
 double FluidResponse::coupling(std::size_t i, std::size_t k) const {
+  // i's gather weights spread over its SPH neighbours, read back by k's
+  for (std::uint32_t p = start_[i]; p < start_[i + 1]; ++p) dense_[a_[p]] = gather_[p];
   double c = 0;
-  std::uint32_t p = start_[i], q = start_[k];
-  while (p < start_[i + 1] && q < start_[k + 1]) {
-    if (a_[p] < a_[q]) {
-      ++p;
-    } else if (a_[q] < a_[p]) {
-      ++q;
-    } else {
-      c += gather_[p] * scatter_[q];
-      ++p, ++q;
-    }
-  }
+  for (std::uint32_t q = start_[k]; q < start_[k + 1]; ++q) c += dense_[a_[q]] * scatter_[q];
+  for (std::uint32_t p = start_[i]; p < start_[i + 1]; ++p) dense_[a_[p]] = 0.0;
   return c;
 }
 

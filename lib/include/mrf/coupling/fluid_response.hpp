@@ -36,7 +36,7 @@ class FluidResponse final : public MobilityCoupling {
   double coupling(std::size_t i, std::size_t k) const override;
 
  private:
-  // Per DEM particle, per SPH neighbour (sorted, images merged): SPH index,
+  // Per DEM particle, per SPH neighbour (images merged): SPH index,
   // scatter weight W / (rho_a s_j) and gather weight m W / (rho_a s_i), so
   // that an application is two passes of three multiply-adds per entry.
   std::vector<std::uint32_t> a_;
@@ -49,7 +49,8 @@ class FluidResponse final : public MobilityCoupling {
   static constexpr std::size_t k_entries_per_thread = 20000;
   std::vector<double> diag_;
   std::vector<double> z_;             // per SPH particle, by component: sum_j W_aj f_j / (rho_a s_j)
-  std::vector<std::uint32_t> order_;  // scratch of set()
+  std::vector<std::int32_t> slot_;    // scratch of set(): SPH particle -> entry of the current row
+  mutable std::vector<double> dense_; // scratch of coupling(): per SPH particle, zero between calls
 };
 
 }  // namespace mrf
