@@ -184,6 +184,22 @@ TEST(CoupledModel, TimeStepIsNotBoundByTheDragRelaxationTime) {
   }
 }
 
+// auto takes the inertialess scheme up to the Stokes bound and the inertial
+// one above it (reports/inertia/stokes_boundary.md: model 3 departs from the
+// inertial stress at St = 3e-2), whatever else binds.
+TEST(CoupledModel, AutoKeepsParticleInertiaAboveTheStokesBound) {
+  for (const auto& [density, inertialess] : {std::pair{"7800", true}, std::pair{"78000", false}}) {
+    const LoadedScene scene = load_scene(kSmall, {"scene.model=\"demsph_dd\"", std::string("particles.density=") + density});
+    const DemParams p = dem_params(scene.config);
+    const ShearCell cell = build_shear_cell(scene.config);
+    const FluidCell f = build_coupled_fluid(scene.config, cell);
+    EXPECT_EQ(stokes_number(p) <= k_inertialess_max_stokes, inertialess) << density;
+    EXPECT_EQ(choose_coupled_time_step(scene, p, f, 0.5).stepping.scheme,
+              inertialess ? CoupledScheme::inertialess : CoupledScheme::inertial)
+        << density;
+  }
+}
+
 // Extreme Mason numbers of the sweep on the small scene, both coupled
 // models and both schemes: runs end without a NumericalError, with finite
 // stress and momentum conserved (Mn = 1 to strain 4: before the SPH walls
