@@ -17,6 +17,7 @@
 
 #include "mrf/error.hpp"
 #include "mrf/io/quantity.hpp"
+#include "mrf/io/toml_text.hpp"
 
 namespace mrf {
 namespace {
@@ -154,21 +155,6 @@ bool is_section(std::string_view name) {
 
 // ---- unknown keys: suggestions -------------------------------------------
 
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diag = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diag = up;
-    }
-  }
-  return row[b.size()];
-}
-
 // The same name in another section, else the closest key (or section) within distance 2.
 std::string suggestion(std::string_view wrong, bool want_section) {
   std::string best;
@@ -235,36 +221,12 @@ std::vector<Found> flatten(const toml::table& doc, const std::string& source) {
   return out;
 }
 
-// "[name]" or "[[name]]" -> name.
-std::string header_name(std::string_view line) {
-  const std::string_view inner = line.substr(0, line.find(']'));
-  const auto b = inner.find_first_not_of('[');
-  return b == std::string_view::npos ? "" : std::string(trim(inner.substr(b)));
-}
-
-// A syntax error names the key on its line, when the line is "name = value".
-std::pair<std::string, std::string> guess_key(std::string_view text, std::uint32_t line) {
-  std::string section, current;
-  std::istringstream in{std::string(text)};
-  std::string l;
-  for (std::uint32_t n = 1; n <= line && std::getline(in, l); ++n) {
-    const std::string_view t = trim(l);
-    if (n == line) current = t;
-    else if (t.starts_with('[')) section = header_name(t);
-  }
-  const auto eq = current.find('=');
-  if (eq == std::string::npos) return {current.empty() ? "(end of file)" : current, ""};
-  const std::string name(trim(std::string_view(current).substr(0, eq)));
-  return {section.empty() ? name : section + "." + name,
-          std::string(trim(std::string_view(current).substr(eq + 1)))};
-}
-
 toml::table parse_toml(std::string_view text, const std::string& source) {
   try {
     return toml::parse(text, source);
   } catch (const toml::parse_error& e) {
     const std::uint32_t line = e.source().begin.line;
-    const auto [key, value] = guess_key(text, line);
+    const auto [key, value] = toml_key_on_line(text, line);
     throw InputError(key, value, source + ":" + std::to_string(line),
                      "TOML syntax error: " + std::string(e.description()));
   }

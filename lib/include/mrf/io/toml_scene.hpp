@@ -33,7 +33,9 @@ LoadedScene load_scene(const std::string& path, const std::vector<std::string>& 
 // "section.key=value" where value is TOML syntax (0.1, "2.5 um", true); a value
 // that is not valid TOML (a bare word such as overdamped, or 2.5 um unquoted) is
 // taken as a string. An override of drive.mason replaces a drive.shear_rate given
-// in the file and vice versa. Validates and fills the derived mason / shear_rate.
+// in the file and vice versa, unless drive.vary = "magnetization" (then both
+// are needed and the magnetisation follows). Validates and fills the derived
+// mason / shear_rate / magnetization.
 LoadedScene parse_scene(std::string_view toml_text, const std::string& source_name,
                         const std::vector<std::string>& overrides = {});
 
