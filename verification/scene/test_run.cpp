@@ -8,7 +8,6 @@
 // Runs use the small scene of experiments/scenes/small_dem_stokes.toml cut to
 // strain 0.3 (warm-up 0.1), about 2500 steps, 1-2 s each.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
@@ -30,6 +29,7 @@
 #include "mrf/scene/build_model.hpp"
 #include "mrf/scene/dem_model.hpp"
 #include "mrf/scene/run.hpp"
+#include "support/files.hpp"
 #include "support/small_scene.hpp"
 
 namespace mrf {
@@ -39,35 +39,7 @@ namespace fs = std::filesystem;
 
 using namespace mrf::test;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 bool same_bits(double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b); }
-
-// A fresh directory under the system temp dir, removed on destruction.
-class TempDir {
- public:
-  TempDir() {
-    static int count = 0;
-    path_ = fs::temp_directory_path() /
-            ("mrf_test_run_" + std::to_string(::getpid()) + "_" + std::to_string(count++));
-    fs::remove_all(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
 
 struct RunResult {
   LoadedScene scene;
@@ -77,10 +49,10 @@ struct RunResult {
 
 RunResult run(const std::vector<std::string>& overrides = {}) {
   RunResult r{scene(overrides), {}, {}, {}};
-  const TempDir dir;
+  const TempDir dir("run");
   r.summary = run_scene(r.scene, RunOptions{dir.path().string(), true});
-  r.json = slurp(dir.path() / "summary.json");
-  r.timeseries = slurp(dir.path() / "timeseries.csv");
+  r.json = read_bytes(dir.path() / "summary.json");
+  r.timeseries = read_bytes(dir.path() / "timeseries.csv");
   return r;
 }
 

@@ -16,10 +16,17 @@ void CoupledModel::inertialess_step() {
   auto& f = cell_.free;
   const std::size_t n = f.size();
   const bool implicit_viscosity = stepping_.implicit_viscosity;
-  // the coupling sees the whole fluid force, the explicit step its non-viscous part
-  std::vector<Vec3> a = fluid_acceleration(true, true);
-  prepare_coupling(a);
-  if (implicit_viscosity) a = fluid_acceleration(false, false);
+  // the coupling sees the whole fluid force, the explicit step with implicit
+  // viscosity its non-viscous part
+  std::vector<Vec3> a = fluid_acceleration(false, true);
+  if (implicit_viscosity) {
+    std::vector<Vec3> whole = a;
+    add_viscous_acceleration(fluid_, whole);
+    prepare_coupling(whole);
+  } else {
+    add_viscous_acceleration(fluid_, a);
+    prepare_coupling(a);
+  }
   const std::vector<Vec3>& fc = implicit_->begin_step(lists_, f, cell_.walls, cell_.box);
   drift_.w0.resize(n);
   drift_.w1.resize(n);

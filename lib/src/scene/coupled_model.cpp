@@ -3,20 +3,19 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <sstream>
 
 #include "mrf/coupling/drag_laws.hpp"
 #include "mrf/error.hpp"
-#include "mrf/forces/drag.hpp"
-#include "mrf/scene/fluid_only.hpp"
 #include "mrf/fluid/fluid_observables.hpp"
 #include "mrf/fluid/kernel.hpp"
 #include "mrf/fluid/viscosity.hpp"
 #include "mrf/fluid/wcsph.hpp"
+#include "mrf/forces/drag.hpp"
 #include "mrf/integrate/stability.hpp"
 #include "mrf/integrate/steps.hpp"
 #include "mrf/scene/dem_model.hpp"
+#include "mrf/scene/fluid_only.hpp"
 #include "mrf/scene/run_series.hpp"
 
 namespace mrf {
