@@ -169,21 +169,29 @@ TEST(Sweep, KilledSweepResumesAndReproduces) {
 namespace mrf {
 namespace {
 
+// Each point's summary.json as its scene states it before a run (no run),
+// under `out`, which is emptied first.
+void write_point_summaries(const SweepSpec& s, const std::vector<SweepPoint>& pts, const std::filesystem::path& out) {
+  std::filesystem::remove_all(out);
+  for (const auto& p : pts) {
+    const LoadedScene scene = load_scene(s.scene_path, p.sets);
+    std::filesystem::create_directories(out / p.dir);
+    std::ofstream(out / p.dir / "summary.json") << summary_json(scene_summary(scene.config));
+  }
+}
+
 // summary.json -> sweep.csv -> the criterion's table: the carrier viscosity
 // and density travel with every point, so a sweep of the SPH models alone
 // has them (the criterion used to rebuild eta from a model-1 row).
 TEST(Sweep, SweepCsvCarriesTheFluidViscosityAndDensity) {
   const auto out = std::filesystem::temp_directory_path() / "mrf_test_sweep_fluid";
-  std::filesystem::remove_all(out);
   const SweepSpec s = parse_sweep(
       "[sweep]\nscene = \"small_dem_stokes.toml\"\nmodels = [\"demsph_dd\"]\nmason = [0.1]\nseeds = [1]\n"
       "set = [\"fluid.viscosity=0.25\", \"fluid.density=960\"]\n",
       "fluid.toml", k_scenes);
   const auto pts = sweep_points(s);
   ASSERT_EQ(pts.size(), 1u);
-  const LoadedScene scene = load_scene(s.scene_path, pts[0].sets);
-  std::filesystem::create_directories(out / pts[0].dir);
-  std::ofstream(out / pts[0].dir / "summary.json") << summary_json(scene_summary(scene.config));
+  write_point_summaries(s, pts, out);
   const std::string csv = sweep_csv(pts, out.string());
   std::ofstream(out / "sweep.csv") << csv;
   const SweepTable t = read_sweep_csv((out / "sweep.csv").string());
@@ -197,7 +205,6 @@ TEST(Sweep, SweepCsvCarriesTheFluidViscosityAndDensity) {
 // (the override used to be the 4-digit label, 0.01235 for 0.0123456789).
 TEST(Sweep, PointSceneAndSweepCsvHoldTheExactMasonNumber) {
   const auto out = std::filesystem::temp_directory_path() / "mrf_test_sweep_mason";
-  std::filesystem::remove_all(out);
   const SweepSpec s = parse_sweep(
       "[sweep]\nscene = \"small_dem_stokes.toml\"\nmodels = [\"dem_stokes\"]\n"
       "mason = [0.0123456789, 0.1, 3.3333333333333335e-5]\nseeds = [1]\n",
@@ -210,9 +217,8 @@ TEST(Sweep, PointSceneAndSweepCsvHoldTheExactMasonNumber) {
     const LoadedScene scene = load_scene(s.scene_path, p.sets);
     EXPECT_EQ(std::bit_cast<std::uint64_t>(scene.config.mason), std::bit_cast<std::uint64_t>(p.mason))
         << p.dir << ": " << scene.config.mason << " != " << p.mason;
-    std::filesystem::create_directories(out / p.dir);
-    std::ofstream(out / p.dir / "summary.json") << summary_json(scene_summary(scene.config));
   }
+  write_point_summaries(s, pts, out);
   std::istringstream csv(sweep_csv(pts, out.string()));
   std::string line;
   std::getline(csv, line);
