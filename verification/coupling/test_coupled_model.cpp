@@ -153,7 +153,9 @@ TEST(CoupledModel, BuoyancyIsModelAVolumeTimesPressureGradient) {
 // relaxation time is shorter), and several times tau_p at Mn = 1e-2. The
 // inertial scheme splits it into contact-bound DEM sub-steps; the
 // inertialess one (auto at this St) takes error-controlled steps up to the
-// implicit scheme's bounds, with no contact or drag limit.
+// implicit scheme's bounds, with no contact or drag limit, and since those
+// are longer than the acoustic step, the SPH step takes sound and viscosity
+// implicitly, bound by advection alone: one SPH step per particle step.
 TEST(CoupledModel, TimeStepIsNotBoundByTheDragRelaxationTime) {
   for (const char* model : {"demsph_stokes", "demsph_dd"}) {
     for (const char* integrator : {"verlet_exp", "auto"}) {
@@ -164,16 +166,21 @@ TEST(CoupledModel, TimeStepIsNotBoundByTheDragRelaxationTime) {
       const FluidCell f = build_coupled_fluid(scene.config, cell);
       const CoupledTimeStep t = choose_coupled_time_step(scene, p, f, 0.5);
       for (const auto& l : t.fluid_limits) EXPECT_EQ(l.name.find("drag"), std::string::npos) << l.name;
-      EXPECT_NEAR(t.stepping.dt_fluid, 0.5 * coupled_viscous_limit(f, 0.5), 1e-20);
       EXPECT_GT(t.stepping.dt_fluid / p.tau_p, 0.25);
       if (std::string(integrator) == "verlet_exp") {
+        EXPECT_NEAR(t.stepping.dt_fluid, 0.5 * coupled_viscous_limit(f, 0.5), 1e-20);
+        EXPECT_EQ(t.stepping.sph, SphImplicit::none);
         EXPECT_EQ(t.stepping.scheme, CoupledScheme::inertial);
         EXPECT_GT(t.stepping.substeps, 5);
       } else {
+        EXPECT_EQ(t.stepping.sph, SphImplicit::pressure_viscosity);
+        EXPECT_EQ(binding(t.fluid_limits).name, "advection");
+        EXPECT_NEAR(t.stepping.dt_fluid, 0.5 * binding(t.fluid_limits).dt, 1e-20);
+        EXPECT_LT(0.5 * binding(stability_limits(f, SphImplicit::viscosity)).dt, t.stepping.dt_max);
         EXPECT_LE(stokes_number(p), k_inertialess_max_stokes);
         EXPECT_EQ(t.stepping.scheme, CoupledScheme::inertialess);
         EXPECT_EQ(t.stepping.dt_max, smallest(dem_limits(p, scene.config.gap, IntegratorId::implicit)));
-        EXPECT_GT(t.stepping.dt_max, 5 * t.stepping.dt_fluid);
+        EXPECT_LE(t.stepping.dt_max, t.stepping.dt_fluid);
         for (const auto& l : t.dem_limits) {
           if (l.name == "hertz contact" || l.name == "drag relaxation") {
             EXPECT_TRUE(std::isinf(l.dt)) << l.name;
@@ -221,8 +228,12 @@ TEST(CoupledModel, SmallSceneRunsAtExtremeMasonNumbers) {
       RunSummary s;
       ASSERT_NO_THROW(s = run_scene(scene, {"", true})) << model << " Mn " << mn << " " << integrator;
       EXPECT_TRUE(std::isfinite(s.stress_total.mean)) << model << " Mn " << mn << " " << integrator;
-      // wall reflections included; implicit viscosity leaves its CG residual
-      EXPECT_LT(s.extra.at("momentum_drift_relative"), s.integrator.find("implicit_viscosity") != std::string::npos ? 1e-8 : 1e-12)
+      // wall reflections included. Backward Euler on the SPH terms sums
+      // the pair terms through the diagonal (1 + dt sum K) x_a: round-off of
+      // 1e-16 x dt|K| (10-100) per step over ~1e3 steps; the CG residual
+      // itself is removed by the solver's uniform correction.
+      const bool implicit_sph = s.integrator.find("+sph_implicit") != std::string::npos;
+      EXPECT_LT(s.extra.at("momentum_drift_relative"), implicit_sph ? 1e-10 : 1e-12)
           << model << " Mn " << mn << " " << integrator;
       RecordProperty(std::string(model) + "_Mn" + mn + "_" + integrator + "_sph_wall_reflections",
                      std::to_string(s.extra.at("sph_wall_reflections")));

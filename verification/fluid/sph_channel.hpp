@@ -43,7 +43,7 @@ inline std::function<double(double)> poiseuille_exact(const FluidCell& c, double
 }
 
 // Explicit dt: half the binding Morris limit.
-inline double explicit_dt(const FluidCell& c) { return 0.5 * binding(stability_limits(c, false)).dt; }
+inline double explicit_dt(const FluidCell& c) { return 0.5 * binding(stability_limits(c, SphImplicit::none)).dt; }
 
 // Advances to time t with steps no longer than dt (the last one shortened
 // so that t is reached exactly).

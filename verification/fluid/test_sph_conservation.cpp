@@ -166,13 +166,13 @@ TEST(SphParams, AutomaticSoundSpeedFollowsMorris) {
 
 TEST(SphParams, LimitsAreNamedAndDtAboveThemRefused) {
   const FluidCell c = channel(15, 100.0, 20.0);
-  const auto lim = stability_limits(c, false);
+  const auto lim = stability_limits(c, SphImplicit::none);
   ASSERT_EQ(lim.size(), 3u);
   EXPECT_EQ(binding(lim).name.rfind("viscous", 0), 0u);
   EXPECT_NEAR(binding(lim).dt, 0.125 * c.h * c.h / k_nu, 1e-20);
-  EXPECT_EQ(stability_limits(c, true).size(), 2u);  // no viscous limit when implicit
+  EXPECT_EQ(stability_limits(c, SphImplicit::viscosity).size(), 2u);  // no viscous limit when implicit
   try {
-    check_time_step(c, 1.01 * binding(lim).dt, false);
+    check_time_step(c, 1.01 * binding(lim).dt, SphImplicit::none);
     FAIL() << "dt above the viscous limit accepted";
   } catch (const InputError& e) {
     EXPECT_EQ(e.key(), "numerics.dt");

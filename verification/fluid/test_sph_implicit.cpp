@@ -42,9 +42,9 @@ TEST(SphImplicit, StableAndBoundedFarBeyondViscousLimit) {
   for (double factor : {10.0, 30.0}) {
     FluidCell c = channel(15, 10.0, 0.0);
     const double dt = factor * viscous_limit(c);
-    ASSERT_LT(dt, binding(stability_limits(c, true)).dt);
-    ASSERT_NO_THROW(check_time_step(c, dt, true));
-    EXPECT_THROW(check_time_step(c, dt, false), InputError);
+    ASSERT_LT(dt, binding(stability_limits(c, SphImplicit::viscosity)).dt);
+    ASSERT_NO_THROW(check_time_step(c, dt, SphImplicit::viscosity));
+    EXPECT_THROW(check_time_step(c, dt, SphImplicit::none), InputError);
     const auto t0 = std::chrono::steady_clock::now();
     run_to(c, 0.05 * k_t_visc, dt, true);
     EXPECT_LT(profile_error(c, couette_exact(c, c.time)), 0.12) << factor << "x";
@@ -74,7 +74,7 @@ TEST(SphImplicit, LowReynoldsHighViscosityStable) {
     ASSERT_LE(reynolds_number(e.params, e.box), 1e-4);
     const double T = k_gap * k_gap * k_rho / eta;
     run_to(e, 0.6 * T, explicit_dt(e), false);
-    const double dt_i = std::min(100 * viscous_limit(i), binding(stability_limits(i, true)).dt);
+    const double dt_i = std::min(100 * viscous_limit(i), binding(stability_limits(i, SphImplicit::viscosity)).dt);
     run_to(i, 0.6 * T, dt_i, true);
     for (const FluidCell* c : {&e, &i}) {
       EXPECT_LT(profile_error(*c, couette_exact(*c, c->time)), 2e-3) << "eta = " << eta;

@@ -139,13 +139,13 @@ void step(FluidCell& c, double dt) {
   finish_step(c, dt);
 }
 
-ImplicitSolveStats step_implicit(FluidCell& c, double dt) {
+ImplicitSolveStats step_implicit(FluidCell& c, double dt, SphImplicit terms) {
   check_state(c, "before");
   std::vector<Vec3> a = external_acceleration(c);
   add_pressure_acceleration(c, a);
   std::vector<Vec3> v(c.fluid.v);
   for (std::size_t i = 0; i < a.size(); ++i) v[i] += dt * a[i];
-  const ImplicitSolveStats stats = solve_implicit_viscosity(c, dt, v);
+  const ImplicitSolveStats stats = solve_implicit_fluid(c, dt, terms, v);
   c.fluid.v = std::move(v);
   finish_step(c, dt);
   return stats;
@@ -153,24 +153,28 @@ ImplicitSolveStats step_implicit(FluidCell& c, double dt) {
 
 double viscous_limit(const FluidCell& c) { return 0.125 * c.h * c.h / c.params.kinematic_viscosity(); }
 
-std::vector<StabilityLimit> stability_limits(const FluidCell& c, bool implicit_viscosity) {
+std::vector<StabilityLimit> stability_limits(const FluidCell& c, SphImplicit implicit) {
   double vmax = wall_speed(c.params.shear_rate, c.box.gap);
   for (const Vec3& v : c.fluid.v) vmax = std::max(vmax, v.norm());
   double fmax = 0.0;
   for (const Vec3& f : external_acceleration(c)) fmax = std::max(fmax, f.norm());
-  std::vector<StabilityLimit> out{{"cfl", 0.25 * c.h / (c.c0 + vmax), "0.25 h/(c0 + |v|max), Morris et al. 1997"}};
-  if (!implicit_viscosity) out.push_back({"viscous", viscous_limit(c), "0.125 h^2/nu, Morris et al. 1997"});
+  std::vector<StabilityLimit> out;
+  if (implicit == SphImplicit::pressure_viscosity)
+    out.push_back({"advection", 0.25 * c.h / vmax, "0.25 h/|v|max (sound implicit)"});
+  else
+    out.push_back({"cfl", 0.25 * c.h / (c.c0 + vmax), "0.25 h/(c0 + |v|max), Morris et al. 1997"});
+  if (implicit == SphImplicit::none) out.push_back({"viscous", viscous_limit(c), "0.125 h^2/nu, Morris et al. 1997"});
   if (fmax > 0.0) out.push_back({"force", 0.25 * std::sqrt(c.h / fmax), "0.25 sqrt(h/|f|max), Morris et al. 1997"});
   return out;
 }
 
-void check_time_step(const FluidCell& c, double dt, bool implicit_viscosity) {
+void check_time_step(const FluidCell& c, double dt, SphImplicit implicit) {
   if (!(dt > 0) || !std::isfinite(dt)) {
     std::ostringstream s;
     s << dt;
     throw InputError("numerics.dt", s.str(), "", "must be positive and finite");
   }
-  for (const StabilityLimit& l : stability_limits(c, implicit_viscosity))
+  for (const StabilityLimit& l : stability_limits(c, implicit))
     if (dt > l.dt) {
       std::ostringstream s, v;
       v << dt;

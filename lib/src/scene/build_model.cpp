@@ -90,13 +90,21 @@ CoupledTimeStep choose_coupled_time_step(const LoadedScene& scene, const DemPara
   s.scheme = inertialess ? CoupledScheme::inertialess : CoupledScheme::inertial;
   // The SPH step: CFL (and force), and the viscous bound of the averaged
   // equations, 0.125 h^2 eps rho_f / eta (the superficial density carries
-  // the momentum), unless the viscosity is implicit.
-  t.fluid_limits = stability_limits(fluid, true);
+  // the momentum), unless the viscosity is implicit. Inertialess, where the
+  // acoustic CFL step is shorter than the particles' largest step, sound is
+  // implicit too: one SPH step per particle step instead of several.
+  t.fluid_limits = stability_limits(fluid, SphImplicit::viscosity);
   const double viscous = coupled_viscous_limit(fluid, eps_min);
-  s.implicit_viscosity = inertialess && k_implicit_viscosity_gain * viscous < smallest(t.fluid_limits);
-  if (!s.implicit_viscosity)
+  const double dem_bound = inertialess ? smallest(dem_limits(p, c.gap, IntegratorId::implicit)) : 0.0;
+  if (inertialess && c.dt_safety * smallest(t.fluid_limits) < (c.dt ? *c.dt : dem_bound)) {
+    s.sph = SphImplicit::pressure_viscosity;
+    t.fluid_limits = stability_limits(fluid, s.sph);
+  } else if (inertialess && k_implicit_viscosity_gain * viscous < smallest(t.fluid_limits)) {
+    s.sph = SphImplicit::viscosity;
+  } else {
     t.fluid_limits.push_back({"viscous (averaged)", viscous,
                               "0.125 h^2 eps rho_f / eta, eps = " + g3(eps_min) + " (superficial density)"});
+  }
   const StabilityLimit& bf = binding(t.fluid_limits);
   if (inertialess) {
     t.dem_limits = dem_limits(p, c.gap, IntegratorId::implicit);
@@ -178,8 +186,7 @@ BuiltModel build_coupled(const LoadedScene& scene, ShearCell cell, const DemPara
   RunSummary& s = b.summary;
   s = scene_summary(c);
   const double dt_dem = inertialess ? st.dt_max : st.dt_fluid / st.substeps;
-  s.integrator = inertialess ? (st.implicit_viscosity ? "inertialess_implicit+sph_implicit_viscosity"
-                                                       : "inertialess_implicit+sph_explicit")
+  s.integrator = inertialess ? std::string("inertialess_implicit+sph_") + to_string(st.sph)
                              : "sph_explicit+dem_verlet_exp_parcel";
   s.binding_limit = inertialess ? binding(ts.dem_limits).name : binding(ts.fluid_limits).name;
   s.dt = dt_dem;
@@ -210,9 +217,12 @@ BuiltModel build_coupled(const LoadedScene& scene, ShearCell cell, const DemPara
     if (inertialess)
       std::fprintf(stderr,
                    "  chosen: inertialess particles (St = %.3g <= %.3g), implicit contacts, error-controlled dt <= "
-                   "%.4g s (bound by '%s'); SPH sub-steps <= %.4g s, viscosity %s; Re_p = %.3g\n",
+                   "%.4g s (bound by '%s'); SPH sub-steps <= %.4g s, %s; Re_p = %.3g\n",
                    s.stokes_number, k_inertialess_max_stokes, st.dt_max, s.binding_limit.c_str(), st.dt_fluid,
-                   st.implicit_viscosity ? "implicit" : "explicit", s.reynolds_number);
+                   st.sph == SphImplicit::pressure_viscosity ? "sound and viscosity implicit"
+                   : st.sph == SphImplicit::viscosity        ? "viscosity implicit"
+                                                             : "explicit",
+                   s.reynolds_number);
     else
       std::fprintf(stderr,
                    "  chosen: inertial particles (St = %.3g), fluid dt = %.4g s (%.3g tau_p) with %d DEM sub-steps "

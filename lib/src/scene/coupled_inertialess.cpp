@@ -15,11 +15,11 @@ namespace mrf {
 void CoupledModel::inertialess_step() {
   auto& f = cell_.free;
   const std::size_t n = f.size();
-  const bool implicit_viscosity = stepping_.implicit_viscosity;
+  const SphImplicit sph = stepping_.sph;
   // the coupling sees the whole fluid force, the explicit step with implicit
   // viscosity its non-viscous part
   std::vector<Vec3> a = fluid_acceleration(false, true);
-  if (implicit_viscosity) {
+  if (sph != SphImplicit::none) {
     std::vector<Vec3> whole = a;
     add_viscous_acceleration(fluid_, whole);
     prepare_coupling(whole);
@@ -66,8 +66,8 @@ void CoupledModel::inertialess_step() {
   for (auto& q : kick) q /= k;
   const double t0 = time_;
   for (int s = 0; s < k; ++s) {
-    if (s > 0) a = fluid_acceleration(!implicit_viscosity, false);
-    advance_fluid(h, kick, a, implicit_viscosity);
+    if (s > 0) a = fluid_acceleration(sph == SphImplicit::none, false);
+    advance_fluid(h, kick, a, sph);
     time_ = t0 + (s + 1) * h;
     refresh(fluid_, sph_pairs_);
   }

@@ -148,7 +148,7 @@ void CoupledModel::finish(RunSummary& s) const {
     report_implicit(implicit_->counters(), time_, steps_, s);
     s.extra["fluid_steps"] = static_cast<double>(fluid_substeps_);
     s.extra["sph_pair_builds"] = static_cast<double>(sph_pairs_.builds);
-    if (stepping_.implicit_viscosity) s.extra["viscous_cg_iterations"] = static_cast<double>(viscous_iterations_);
+    if (stepping_.sph != SphImplicit::none) s.extra["viscous_cg_iterations"] = static_cast<double>(viscous_iterations_);
   } else {
     s.steps = steps_ * substeps_;  // DEM sub-steps
     s.extra["fluid_steps"] = static_cast<double>(steps_);
@@ -314,11 +314,12 @@ void CoupledModel::exchange_with_fluid(const std::vector<Vec3>& impulse, std::ve
   sums_.exchange_virial = -exchange_virial / (dt * fluid_.box.volume());
 }
 
-// The SPH particles over dt: v += dt a + kick (and the viscous term by
-// backward Euler where `implicit_viscosity`), x += dt v; the wall particles
-// move with the walls. `a` holds the accelerations at the start.
+// The SPH particles over dt: v += dt a + kick (and the viscous term, or
+// the viscous term and the pressure increment, by backward Euler where
+// `implicit` says), x += dt v; the wall particles move with the walls. `a`
+// holds the accelerations at the start.
 void CoupledModel::advance_fluid(double dt, const std::vector<Vec3>& kick, std::vector<Vec3>& a,
-                                 bool implicit_viscosity) {
+                                 SphImplicit implicit) {
   const std::size_t nf = fluid_.fluid.size();
   Vec3 fluid_force = Vec3::Zero();
   for (std::size_t b = 0; b < nf; ++b) {
@@ -326,13 +327,12 @@ void CoupledModel::advance_fluid(double dt, const std::vector<Vec3>& kick, std::
     fluid_force += a[b];
   }
   external_impulse_ += (dt * fluid_.mass) * fluid_force;  // SPH pair terms cancel: walls + body force
-  if (implicit_viscosity) {
-    viscous_iterations_ += solve_implicit_viscosity(fluid_, dt, fluid_.fluid.v).iterations;
-    // The walls' viscous push at the new velocities, summed on its own: what
-    // the fluid-fluid terms leave of the momentum change is the CG residual.
-    Vec3 wall = Vec3::Zero();
-    for (const SphPair& pr : fluid_.pairs.fluid_wall) wall += wall_viscous_acceleration(fluid_, pr);
-    external_impulse_ += (dt * fluid_.mass) * wall;
+  if (implicit != SphImplicit::none) {
+    const ImplicitSolveStats st = solve_implicit_fluid(fluid_, dt, implicit, fluid_.fluid.v);
+    viscous_iterations_ += st.iterations;
+    // The walls' push at the new velocities, summed on its own: what the
+    // fluid-fluid terms leave of the momentum change is the CG residual.
+    external_impulse_ += fluid_.mass * st.wall_dv;
   }
   const double half = 0.5 * fluid_.box.gap;
   for (std::size_t b = 0; b < nf; ++b) {
@@ -383,7 +383,7 @@ void CoupledModel::step() {
   std::vector<Vec3> exchange(n), kick;
   for (std::size_t i = 0; i < n; ++i) exchange[i] = parcel_.impulse[i] + dt_ * buoyancy_[i];
   exchange_with_fluid(exchange, kick, dt_);
-  advance_fluid(dt_, kick, a, false);
+  advance_fluid(dt_, kick, a, SphImplicit::none);
   time_ += dt_;
   fluid_.time = time_;
   ++steps_;

@@ -32,7 +32,7 @@ void validate_scene(const SceneConfig& cfg, double t_end) {
 bool use_implicit(const SceneConfig& cfg, const FluidCell& cell) {
   if (cfg.integrator == IntegratorId::implicit) return true;
   if (cfg.integrator != IntegratorId::automatic) return false;
-  return viscous_limit(cell) < smallest(stability_limits(cell, true));
+  return viscous_limit(cell) < smallest(stability_limits(cell, SphImplicit::viscosity));
 }
 
 }  // namespace
@@ -51,10 +51,10 @@ FluidOnlyChoice choose_fluid_only_step(const SceneConfig& cfg, const FluidCell& 
   validate_scene(cfg, t_end);
   FluidOnlyChoice c;
   c.implicit_viscosity = use_implicit(cfg, cell);
-  c.limits = stability_limits(cell, c.implicit_viscosity);
+  c.limits = stability_limits(cell, c.implicit_viscosity ? SphImplicit::viscosity : SphImplicit::none);
   double dt = cfg.dt_safety * smallest(c.limits);
   if (cfg.dt) {
-    check_time_step(cell, *cfg.dt, c.implicit_viscosity);
+    check_time_step(cell, *cfg.dt, c.implicit_viscosity ? SphImplicit::viscosity : SphImplicit::none);
     dt = *cfg.dt;
   }
   c.steps = static_cast<long>(std::ceil(t_end / dt - 1e-9));

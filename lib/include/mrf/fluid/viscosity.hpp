@@ -1,6 +1,6 @@
 // Morris, Fox & Zhu (1997) laminar viscosity and no-slip walls
 // (REFERENCE.md §5, momentum equation, second term; walls, Morris 1997),
-// explicit and implicit (backward Euler).
+// explicit; backward Euler in implicit_fluid.hpp.
 #pragma once
 #include <algorithm>
 #include <vector>
@@ -55,23 +55,9 @@ inline double wall_distance(const FluidCell& c, const Vec3& x, int side) {
 // Adds the Morris viscous acceleration of every fluid particle to a (m/s^2).
 void add_viscous_acceleration(const FluidCell& c, std::vector<Vec3>& a);
 
-// Viscous acceleration of fluid particle `pr.a` from wall particle `pr.b`.
+// Viscous acceleration of fluid particle `pr.a` from wall particle `pr.b`:
+// wall_viscous_weight x (v_a - v_w), the weight K_aB beta_aB (1/s, <= 0).
 Vec3 wall_viscous_acceleration(const FluidCell& c, const SphPair& pr);
-
-struct ImplicitSolveStats {
-  int iterations = 0;     // CG iterations (the three components together)
-  double residual = 0;    // relative residual reached
-};
-
-// Backward Euler on the viscous term: solves
-//   (I - dt L) v_new = v + dt g,
-// L the Morris operator among fluid particles (symmetric, K_ab = K_ba), with
-// the wall terms on the diagonal and in g (they keep the matrix symmetric
-// positive definite, so conjugate gradients with a Jacobi preconditioner
-// applies; matrix-free, the three components in one solve for the
-// correction to the predictor). `v` holds the predictor on entry, v_new on
-// exit. Throws NumericalError when the residual of all three components
-// together does not reach params.cg_tolerance of the right-hand side.
-ImplicitSolveStats solve_implicit_viscosity(const FluidCell& c, double dt, std::vector<Vec3>& v);
+double wall_viscous_weight(const FluidCell& c, const SphPair& pr);
 
 }  // namespace mrf

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "mrf/fluid/fluid_cell.hpp"
+#include "mrf/fluid/implicit_fluid.hpp"
 #include "mrf/fluid/viscosity.hpp"
 #include "mrf/integrate/limit.hpp"
 
@@ -47,19 +48,21 @@ std::vector<Vec3> external_acceleration(const FluidCell& c);
 // state or a fluid particle beyond a wall plane, naming particle and step.
 void step(FluidCell& c, double dt);
 
-// Pressure and forces explicit, viscosity by backward Euler
-// (solve_implicit_viscosity), then x += dt v_new. dt is free of the viscous
-// limit; accuracy is first order in dt. Same checks as step().
-ImplicitSolveStats step_implicit(FluidCell& c, double dt);
+// Forces explicit, viscosity (or viscosity and the pressure increment) by
+// backward Euler (implicit_fluid.hpp), then x += dt v_new. dt is free of the
+// viscous limit (and of the acoustic one); accuracy is first order in dt.
+// Same checks as step().
+ImplicitSolveStats step_implicit(FluidCell& c, double dt, SphImplicit terms = SphImplicit::viscosity);
 
-// Morris et al. (1997) limits (REFERENCE §5): CFL 0.25 h/(c0 + |v|max),
-// viscous 0.125 h^2/nu (left out when viscosity is implicit) and force
-// 0.25 sqrt(h/|f|max) (left out when there is no force).
-std::vector<StabilityLimit> stability_limits(const FluidCell& c, bool implicit_viscosity);
+// Morris et al. (1997) limits (REFERENCE §5): CFL 0.25 h/(c0 + |v|max)
+// (with implicit pressure the advective 0.25 h/|v|max), viscous 0.125 h^2/nu
+// (left out when viscosity is implicit) and force 0.25 sqrt(h/|f|max) (left
+// out when there is no force).
+std::vector<StabilityLimit> stability_limits(const FluidCell& c, SphImplicit implicit);
 // The viscous one alone (s): whether it binds decides implicit viscosity.
 double viscous_limit(const FluidCell& c);
 
 // Throws InputError (key numerics.dt) if dt exceeds a limit, naming it.
-void check_time_step(const FluidCell& c, double dt, bool implicit_viscosity);
+void check_time_step(const FluidCell& c, double dt, SphImplicit implicit);
 
 }  // namespace mrf

@@ -44,6 +44,7 @@
 #include "mrf/coupling/exchange.hpp"
 #include "mrf/coupling/fluid_response.hpp"
 #include "mrf/fluid/fluid_cell.hpp"
+#include "mrf/fluid/implicit_fluid.hpp"
 #include "mrf/integrate/coupled_steps.hpp"
 #include "mrf/integrate/implicit_stepper.hpp"
 #include "mrf/io/archive.hpp"
@@ -63,7 +64,9 @@ struct CoupledStepping {
   double dt_fluid = 0;    // s: inertial, the fluid step; inertialess, the longest SPH sub-step
   int substeps = 1;       // inertial: DEM sub-steps per fluid step
   double dt_max = 0;      // inertialess: longest step (stability bounds of the explicit parts, s)
-  bool implicit_viscosity = false;  // inertialess: SPH viscosity by backward Euler (dt_fluid then the CFL bound)
+  // inertialess: the SPH terms taken by backward Euler (viscosity: dt_fluid
+  // then the CFL bound; pressure and viscosity: the advective bound)
+  SphImplicit sph = SphImplicit::none;
   double sph_skin = 0;    // inertialess: Verlet skin of the SPH pairs (m; 0 = search every sub-step)
   ImplicitOptions implicit;  // inertialess
 };
@@ -107,7 +110,7 @@ class CoupledModel final : public Model {
   std::string progress() const override;
   long fluid_substeps() const { return fluid_substeps_; }  // inertialess: SPH sub-steps so far
   long sph_pair_builds() const { return sph_pairs_.builds; }
-  long viscous_iterations() const { return viscous_iterations_; }  // implicit viscosity: CG iterations so far
+  long viscous_iterations() const { return viscous_iterations_; }  // implicit SPH: CG iterations so far
 
   const ShearCell& cell() const override { return cell_; }
   const FluidCell& fluid() const { return fluid_; }
@@ -166,7 +169,7 @@ class CoupledModel final : public Model {
   // SPH forces per unit mass (with or without viscosity); `sample` sets the
   // fluid stress sums of the step
   std::vector<Vec3> fluid_acceleration(bool viscous, bool sample);
-  void advance_fluid(double dt, const std::vector<Vec3>& kick, std::vector<Vec3>& a, bool implicit_viscosity);
+  void advance_fluid(double dt, const std::vector<Vec3>& kick, std::vector<Vec3>& a, SphImplicit implicit);
   void exchange_with_fluid(const std::vector<Vec3>& impulse, std::vector<Vec3>& kick, double dt);
 
   ShearCell cell_;

@@ -1,0 +1,196 @@
+#include "mrf/fluid/implicit_fluid.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "mrf/error.hpp"
+#include "mrf/fluid/kernel.hpp"
+#include "mrf/fluid/viscosity.hpp"
+#include "mrf/integrate/pcg.hpp"
+
+namespace mrf {
+
+const char* to_string(SphImplicit s) {
+  switch (s) {
+    case SphImplicit::none: return "explicit";
+    case SphImplicit::viscosity: return "implicit_viscosity";
+    default: return "implicit";
+  }
+}
+
+ImplicitFluidSystem::ImplicitFluidSystem(const FluidCell& c, double dt, SphImplicit terms)
+    : c_(c), dt_(dt), pressure_(terms == SphImplicit::pressure_viscosity) {
+  const std::size_t n = c.fluid.size();
+  const auto& rho = c.fluid.rho;
+  const auto& pairs = c.pairs.fluid_fluid;
+  const auto& wall_pairs = c.pairs.fluid_wall;
+  k_.resize(pairs.size());
+  kw_.resize(wall_pairs.size());
+  vdiag_.assign(n, 1.0);
+  for (std::size_t e = 0; e < pairs.size(); ++e) {
+    const SphPair& pr = pairs[e];
+    k_[e] = -dt * morris_weight(pr.r, c.h, c.mass, effective_viscosity(c), rho[pr.a], rho[pr.b]);
+    vdiag_[pr.a] += k_[e];
+    vdiag_[pr.b] += k_[e];
+  }
+  for (std::size_t e = 0; e < wall_pairs.size(); ++e) {
+    kw_[e] = -dt * wall_viscous_weight(c, wall_pairs[e]);
+    vdiag_[wall_pairs[e].a] += kw_[e];
+  }
+  diag_.resize(n);
+  for (std::size_t a = 0; a < n; ++a) diag_[a] = Vec3::Constant(vdiag_[a]);
+  if (!pressure_) return;
+  const double scale = c.mass * c.density_scale;
+  g_.resize(pairs.size());
+  for (std::size_t e = 0; e < pairs.size(); ++e) g_[e] = scale * kernel_dwdr_over_r(pairs[e].r, c.h) * pairs[e].r_ab;
+  tw_.assign(n, Vec3::Zero());
+  d0_.assign(n, 0.0);
+  for (const SphPair& pr : wall_pairs) {
+    const Vec3 g = scale * kernel_dwdr_over_r(pr.r, c.h) * pr.r_ab;
+    tw_[pr.a] += g;
+    d0_[pr.a] -= g.dot(c.wall.v[pr.b]);
+  }
+  q_.resize(n);
+  const bool porous = !c.fluid.eps.empty();
+  for (std::size_t a = 0; a < n; ++a) {
+    const double k = c.c0 * c.c0 / (porous ? c.fluid.eps[a] : 1.0);
+    q_[a] = dt * dt * k / (c.density_scale * rho[a] * rho[a]);
+  }
+  // diagonal of D^T Q D: Q_a T_a T_a^T + sum_b Q_b g_ab g_ab^T, T_a the
+  // derivative of (D v)_a by v_a (component-wise, for the preconditioner)
+  std::vector<Vec3> t(tw_);
+  for (std::size_t e = 0; e < pairs.size(); ++e) {
+    t[pairs[e].a] += g_[e];
+    t[pairs[e].b] -= g_[e];
+    const Vec3 g2 = g_[e].cwiseProduct(g_[e]);
+    diag_[pairs[e].a] += q_[pairs[e].b] * g2;
+    diag_[pairs[e].b] += q_[pairs[e].a] * g2;
+  }
+  for (std::size_t a = 0; a < n; ++a) diag_[a] += q_[a] * t[a].cwiseProduct(t[a]);
+}
+
+std::vector<double> ImplicitFluidSystem::density_change(const std::vector<Vec3>& v) const {
+  const auto& pairs = c_.pairs.fluid_fluid;
+  std::vector<double> d(v.size(), 0.0);
+  if (!pressure_) return d;
+  for (std::size_t a = 0; a < v.size(); ++a) d[a] = tw_[a].dot(v[a]) + d0_[a];
+  for (std::size_t e = 0; e < pairs.size(); ++e) {
+    const double x = g_[e].dot(v[pairs[e].a] - v[pairs[e].b]);
+    d[pairs[e].a] += x;
+    d[pairs[e].b] += x;
+  }
+  for (double& x : d) x *= dt_;
+  return d;
+}
+
+// out += dt^2 S1 D^T Q (D x + with_d0 d0); s_ keeps Q (D x + d0) dt^2 S1
+void ImplicitFluidSystem::add_pressure(const std::vector<Vec3>& x, bool with_d0, std::vector<Vec3>& out) const {
+  const auto& pairs = c_.pairs.fluid_fluid;
+  const std::size_t n = x.size();
+  s_.resize(n);
+  for (std::size_t a = 0; a < n; ++a) s_[a] = tw_[a].dot(x[a]) + (with_d0 ? d0_[a] : 0.0);
+  for (std::size_t e = 0; e < pairs.size(); ++e) {
+    const double d = g_[e].dot(x[pairs[e].a] - x[pairs[e].b]);
+    s_[pairs[e].a] += d;
+    s_[pairs[e].b] += d;
+  }
+  for (std::size_t a = 0; a < n; ++a) {
+    s_[a] *= q_[a];
+    out[a] += s_[a] * tw_[a];
+  }
+  for (std::size_t e = 0; e < pairs.size(); ++e) {
+    const Vec3 f = (s_[pairs[e].a] + s_[pairs[e].b]) * g_[e];
+    out[pairs[e].a] += f;
+    out[pairs[e].b] -= f;
+  }
+}
+
+void ImplicitFluidSystem::apply(const std::vector<Vec3>& x, std::vector<Vec3>& out) const {
+  const auto& pairs = c_.pairs.fluid_fluid;
+  const std::size_t n = x.size();
+  out.resize(n);
+  for (std::size_t a = 0; a < n; ++a) out[a] = vdiag_[a] * x[a];
+  for (std::size_t e = 0; e < pairs.size(); ++e) {
+    out[pairs[e].a] -= k_[e] * x[pairs[e].b];
+    out[pairs[e].b] -= k_[e] * x[pairs[e].a];
+  }
+  if (pressure_) add_pressure(x, false, out);
+}
+
+std::vector<Vec3> ImplicitFluidSystem::rhs(const std::vector<Vec3>& v_star) const {
+  std::vector<Vec3> r(v_star);
+  for (std::size_t e = 0; e < kw_.size(); ++e) r[c_.pairs.fluid_wall[e].a] += kw_[e] * c_.wall.v[c_.pairs.fluid_wall[e].b];
+  if (pressure_) {
+    std::vector<Vec3> known(r.size(), Vec3::Zero());
+    add_pressure(std::vector<Vec3>(r.size(), Vec3::Zero()), true, known);
+    for (std::size_t a = 0; a < r.size(); ++a) r[a] -= known[a];
+  }
+  return r;
+}
+
+Vec3 ImplicitFluidSystem::wall_push(const std::vector<Vec3>& v) const {
+  // viscous dt K beta (v_a - v_w) = -kw (v_a - v_w); pressure -s_a T_a, s = Q (D v + d0)
+  Vec3 push = Vec3::Zero();
+  for (std::size_t e = 0; e < kw_.size(); ++e)
+    push -= kw_[e] * (v[c_.pairs.fluid_wall[e].a] - c_.wall.v[c_.pairs.fluid_wall[e].b]);
+  if (pressure_) {
+    std::vector<Vec3> scratch(v.size(), Vec3::Zero());
+    add_pressure(v, true, scratch);
+    for (std::size_t a = 0; a < v.size(); ++a) push -= s_[a] * tw_[a];
+  }
+  return push;
+}
+
+Eigen::Matrix3d ImplicitFluidSystem::uniform_response() const {
+  Eigen::Matrix3d m = Eigen::Matrix3d::Identity() * static_cast<double>(c_.fluid.size());
+  for (double k : kw_) m.diagonal().array() += k;
+  if (pressure_)
+    for (std::size_t a = 0; a < tw_.size(); ++a) m += q_[a] * tw_[a] * tw_[a].transpose();
+  return m;
+}
+
+ImplicitSolveStats solve_implicit_fluid(const FluidCell& c, double dt, SphImplicit terms, std::vector<Vec3>& v) {
+  // One PCG on the three velocity components together, for the correction
+  // to the predictor v, Jacobi-preconditioned.
+  const std::size_t n = c.fluid.size();
+  const ImplicitFluidSystem sys(c, dt, terms);
+  const std::vector<Vec3> rhs = sys.rhs(v);
+  const std::vector<Vec3>& diag = sys.diagonal();
+  auto apply = [&](const std::vector<Vec3>& x, std::vector<Vec3>& out) { sys.apply(x, out); };
+  std::vector<Vec3> av, b(n), d;
+  apply(v, av);
+  for (std::size_t a = 0; a < n; ++a) b[a] = rhs[a] - av[a];
+  // stop where |residual| <= cg_tolerance |rhs|, as for a solve from zero
+  const double bn = std::sqrt(vector_dot(b, b)), rn = std::sqrt(vector_dot(rhs, rhs));
+  ImplicitSolveStats stats;
+  if (bn > c.params.cg_tolerance * rn) {
+    PcgScratch<Vec3> cg;
+    const double rtol = c.params.cg_tolerance * rn / bn;
+    stats.iterations = static_cast<int>(pcg(
+        b, rtol, 10 * static_cast<long>(n) + 10, apply,
+        [&](const std::vector<Vec3>& r, std::vector<Vec3>& z) {
+          z.resize(n);
+          for (std::size_t a = 0; a < n; ++a) z[a] = r[a].cwiseQuotient(diag[a]);
+        },
+        d, cg));
+    stats.residual = std::sqrt(vector_dot(cg.r, cg.r)) / rn;
+    if (!(stats.residual <= c.params.cg_tolerance)) {
+      std::ostringstream m;
+      m << "SPH implicit " << (terms == SphImplicit::pressure_viscosity ? "pressure and viscosity" : "viscosity")
+        << ": CG did not converge at step " << c.steps << " (t = " << c.time << " s, dt = " << dt
+        << " s, relative residual " << stats.residual << ")";
+      throw NumericalError(m.str());
+    }
+    for (std::size_t a = 0; a < n; ++a) v[a] += d[a];
+  }
+  // momentum: sum_a (rhs - A v)_a = 0 by a uniform shift u, (sum_a A 1) u = sum r
+  apply(v, av);
+  Vec3 r_sum = Vec3::Zero();
+  for (std::size_t a = 0; a < n; ++a) r_sum += rhs[a] - av[a];
+  const Vec3 u = sys.uniform_response().ldlt().solve(r_sum);
+  for (Vec3& x : v) x += u;
+  stats.wall_dv = sys.wall_push(v);
+  return stats;
+}
+
+}  // namespace mrf
