@@ -69,16 +69,22 @@ ImplicitFluidSystem::ImplicitFluidSystem(const FluidCell& c, double dt, SphImpli
   for (std::size_t a = 0; a < n; ++a) diag_[a] += q_[a] * t[a].cwiseProduct(t[a]);
 }
 
-std::vector<double> ImplicitFluidSystem::density_change(const std::vector<Vec3>& v) const {
+// s = D x (+ d0)
+void ImplicitFluidSystem::divergence(const std::vector<Vec3>& x, bool with_d0, std::vector<double>& s) const {
   const auto& pairs = c_.pairs.fluid_fluid;
+  s.resize(x.size());
+  for (std::size_t a = 0; a < x.size(); ++a) s[a] = tw_[a].dot(x[a]) + (with_d0 ? d0_[a] : 0.0);
+  for (std::size_t e = 0; e < pairs.size(); ++e) {
+    const double d = g_[e].dot(x[pairs[e].a] - x[pairs[e].b]);
+    s[pairs[e].a] += d;
+    s[pairs[e].b] += d;
+  }
+}
+
+std::vector<double> ImplicitFluidSystem::density_change(const std::vector<Vec3>& v) const {
   std::vector<double> d(v.size(), 0.0);
   if (!pressure_) return d;
-  for (std::size_t a = 0; a < v.size(); ++a) d[a] = tw_[a].dot(v[a]) + d0_[a];
-  for (std::size_t e = 0; e < pairs.size(); ++e) {
-    const double x = g_[e].dot(v[pairs[e].a] - v[pairs[e].b]);
-    d[pairs[e].a] += x;
-    d[pairs[e].b] += x;
-  }
+  divergence(v, true, d);
   for (double& x : d) x *= dt_;
   return d;
 }
@@ -87,13 +93,7 @@ std::vector<double> ImplicitFluidSystem::density_change(const std::vector<Vec3>&
 void ImplicitFluidSystem::add_pressure(const std::vector<Vec3>& x, bool with_d0, std::vector<Vec3>& out) const {
   const auto& pairs = c_.pairs.fluid_fluid;
   const std::size_t n = x.size();
-  s_.resize(n);
-  for (std::size_t a = 0; a < n; ++a) s_[a] = tw_[a].dot(x[a]) + (with_d0 ? d0_[a] : 0.0);
-  for (std::size_t e = 0; e < pairs.size(); ++e) {
-    const double d = g_[e].dot(x[pairs[e].a] - x[pairs[e].b]);
-    s_[pairs[e].a] += d;
-    s_[pairs[e].b] += d;
-  }
+  divergence(x, with_d0, s_);
   for (std::size_t a = 0; a < n; ++a) {
     s_[a] *= q_[a];
     out[a] += s_[a] * tw_[a];

@@ -64,6 +64,7 @@ class ImplicitFluidSystem {
   Eigen::Matrix3d uniform_response() const;
 
  private:
+  void divergence(const std::vector<Vec3>& x, bool with_d0, std::vector<double>& s) const;  // s = D x (+ d0)
   void add_pressure(const std::vector<Vec3>& x, bool with_d0, std::vector<Vec3>& out) const;
   const FluidCell& c_;
   double dt_;
