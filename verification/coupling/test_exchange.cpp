@@ -3,6 +3,7 @@
 // back-reaction conserves momentum exactly). Fluid from build_fluid_cell
 // (simple cubic lattice, h/dx = 1.3, Wendland C2), MRF-scale particles.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -48,6 +49,29 @@ TEST(CouplingExchange, PairsMatchBruteForce) {
   const auto dem = random_points(50, -0.5 * c.box.gap, 0.5 * c.box.gap, c.box, 1);
   const auto pairs = coupling_pairs(dem, c.fluid.x, c.box, c.h);
   EXPECT_EQ(pairs.size(), brute_force_cross_pairs(dem, c.fluid.x, c.box, 2.0 * c.h).size());
+}
+
+// The search runs in blocks of DEM particles on threads; the list is the
+// same, entry for entry and in the same order, on 1, 2 and 3 threads (and
+// above the block threshold, 1000 DEM particles).
+TEST(CouplingExchange, PairsAreTheSameOnAnyNumberOfThreads) {
+  const FluidCell c = make_cell();
+  const auto dem = random_points(2500, -0.5 * c.box.gap, 0.5 * c.box.gap, c.box, 5);
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const auto one = coupling_pairs(dem, c.fluid.x, c.box, c.h);
+  for (int t : {2, 3}) {
+    omp_set_num_threads(t);
+    const auto many = coupling_pairs(dem, c.fluid.x, c.box, c.h);
+    ASSERT_EQ(many.size(), one.size()) << t << " threads";
+    for (std::size_t k = 0; k < one.size(); ++k) {
+      ASSERT_EQ(many[k].i, one[k].i) << k;
+      ASSERT_EQ(many[k].a, one[k].a) << k;
+      ASSERT_EQ(many[k].w, one[k].w) << k;
+    }
+  }
+  omp_set_num_threads(saved);
+  EXPECT_TRUE(std::is_sorted(one.begin(), one.end(), [](const CouplingPair& x, const CouplingPair& y) { return x.i < y.i; }));
 }
 
 // A box narrower than 4h: a pair interacts through two periodic images, and

@@ -1,6 +1,8 @@
 // Unresolved SPH-DEM coupling kernels, REFERENCE.md §6. See exchange.hpp.
 #include "mrf/coupling/exchange.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <stdexcept>
 #include <string>
@@ -10,6 +12,11 @@
 #include "mrf/neighbors/cell_list.hpp"
 
 namespace mrf {
+
+namespace {
+// DEM particles per thread below which the pair search stays serial
+constexpr std::size_t k_coupling_rows_per_thread = 1000;
+}  // namespace
 
 void coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x, const Box& box, double h,
                     std::vector<CouplingPair>& out) {
@@ -30,24 +37,39 @@ void coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph
   CellGrid grid(box, x_lo - rc, x_hi + rc, rc);
   grid.bin(sph_x);
   const MinImageYZ mi(box);
-  out.clear();
-  for (std::uint32_t i = 0; i < dem_x.size(); ++i) {
-    const Vec3 xi = dem_x[i];
-    grid.for_each_candidate(xi, [&](std::uint32_t a) {
-      const Vec3& xa = sph_x[a];
-      const double dx = xi.x() - xa.x(), dx2 = dx * dx;
-      if (dx2 >= rc2) return;  // x is not periodic: cheap rejection first
-      const double dy = mi.wrap_y(xi.y() - xa.y()), dz = mi.wrap_z(xi.z() - xa.z());
-      for (int iz = -kz; iz <= kz; ++iz) {
-        const double ez = dz + iz * box.lz, rxz = dx2 + ez * ez;
-        if (rxz >= rc2) continue;
-        for (int iy = -ky; iy <= ky; ++iy) {
-          const double ey = dy + iy * box.ly, r2 = rxz + ey * ey;
-          if (r2 < rc2) out.push_back({i, a, kernel_w(std::sqrt(r2), h)});
+  // DEM particles in contiguous blocks, one per thread, each filling its
+  // own list; the lists are joined in block order, so the pairs come in
+  // the same order (by DEM index) whatever the number of threads.
+  const std::size_t n = dem_x.size();
+  const int blocks = n >= k_coupling_rows_per_thread ? std::max(1, omp_get_max_threads()) : 1;
+  std::vector<std::vector<CouplingPair>> part(static_cast<std::size_t>(blocks));
+#pragma omp parallel for schedule(static, 1) if (blocks > 1)
+  for (int blk = 0; blk < blocks; ++blk) {
+    std::vector<CouplingPair>& mine = blk == 0 ? out : part[static_cast<std::size_t>(blk)];
+    mine.clear();
+    const std::size_t lo = n * static_cast<std::size_t>(blk) / static_cast<std::size_t>(blocks);
+    const std::size_t hi = n * static_cast<std::size_t>(blk + 1) / static_cast<std::size_t>(blocks);
+    for (std::size_t ii = lo; ii < hi; ++ii) {
+      const auto i = static_cast<std::uint32_t>(ii);
+      const Vec3 xi = dem_x[i];
+      grid.for_each_candidate(xi, [&](std::uint32_t a) {
+        const Vec3& xa = sph_x[a];
+        const double dx = xi.x() - xa.x(), dx2 = dx * dx;
+        if (dx2 >= rc2) return;  // x is not periodic: cheap rejection first
+        const double dy = mi.wrap_y(xi.y() - xa.y()), dz = mi.wrap_z(xi.z() - xa.z());
+        for (int iz = -kz; iz <= kz; ++iz) {
+          const double ez = dz + iz * box.lz, rxz = dx2 + ez * ez;
+          if (rxz >= rc2) continue;
+          for (int iy = -ky; iy <= ky; ++iy) {
+            const double ey = dy + iy * box.ly, r2 = rxz + ey * ey;
+            if (r2 < rc2) mine.push_back({i, a, kernel_w(std::sqrt(r2), h)});
+          }
         }
-      }
-    });
+      });
+    }
   }
+  for (int blk = 1; blk < blocks; ++blk) out.insert(out.end(), part[static_cast<std::size_t>(blk)].begin(),
+                                                     part[static_cast<std::size_t>(blk)].end());
 }
 
 std::vector<CouplingPair> coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x,
