@@ -1,7 +1,7 @@
 // The `mrf` command line (DESIGN.md §Interfaces).
 //   mrf run SCENE.toml [--set section.key=value]... [--out DIR] [--quiet] [--resume] [--checkpoint-every S]
 //   mrf criterion SWEEP_DIR|RUN_DIR [--thresholds FILE]
-//   mrf sweep SWEEP.toml [--out DIR] [--quiet] [--estimate]   (mpirun -n K splits the points)
+//   mrf sweep SWEEP.toml [--out DIR] [--quiet] [--estimate | --list] [--point K]   (mpirun -n K splits the points)
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -47,8 +47,8 @@ int export_lammps(const std::string& scene_path, const std::vector<std::string>&
   return 0;
 }
 
-int sweep_command(const std::string& sweep_path, std::string out, bool quiet, bool estimate_only, int rank,
-                  int ranks) {
+int sweep_command(const std::string& sweep_path, std::string out, bool quiet, bool estimate_only, bool list, int rank,
+                  int ranks, long point) {
   const mrf::SweepSpec spec = mrf::load_sweep(sweep_path);
   if (out.empty()) out = "out/sweeps/" + std::filesystem::path(sweep_path).stem().string();
   mrf::SweepOptions opt;
@@ -58,6 +58,27 @@ int sweep_command(const std::string& sweep_path, std::string out, bool quiet, bo
     if (rank < 0 || rank >= ranks)
       throw mrf::InputError("--rank", std::to_string(rank), "", "must be in [0, --ranks)");
     opt.rank = {rank, ranks};
+  }
+  if (point >= 0 && ranks > 0)
+    throw mrf::InputError("--point", std::to_string(point), "", "runs one point; leave out --rank/--ranks");
+  opt.point = point;
+  if (list) {
+    // index, folder, state and estimate of every point: what a job array or
+    // GNU parallel needs to hand `--point K` out
+    const auto points = mrf::sweep_points(spec);
+    std::printf("%-5s %-40s %-14s %-9s %-5s %-9s %s\n", "point", "folder", "model", "Mn", "seed", "state",
+                "estimate (s)");
+    for (const auto& p : points) {
+      const std::filesystem::path dir = std::filesystem::path(out) / p.dir;
+      const char* state = std::filesystem::exists(dir / "summary.json")   ? "finished"
+                          : std::filesystem::exists(dir / "failure.json") ? "failed"
+                          : std::filesystem::exists(dir / "checkpoint.bin") ? "started"
+                                                                              : "todo";
+      std::printf("%-5zu %-40s %-14s %-9g %-5llu %-9s %.3g\n", p.index, p.dir.c_str(), p.model.c_str(), p.mason,
+                  static_cast<unsigned long long>(p.seed), state,
+                  mrf::estimate_point_seconds(spec.scene_path, p.sets, opt.cost_rate));
+    }
+    return 0;
   }
   if (estimate_only) {
     const auto points = mrf::sweep_points(spec);
@@ -71,7 +92,11 @@ int sweep_command(const std::string& sweep_path, std::string out, bool quiet, bo
     return 0;
   }
   const mrf::SweepOutcome o = mrf::run_sweep(spec, out, opt);
-  std::printf("sweep %s rank %d/%d: %zu run, %zu skipped (finished before), %zu failed, %.1f s -> %s/sweep.csv\n",
+  if (point >= 0)
+    std::printf("sweep %s point %ld: %zu run, %zu skipped (finished before), %zu failed, %.1f s -> %s/sweep.csv\n",
+                sweep_path.c_str(), point, o.ran, o.skipped, o.failed, o.seconds, out.c_str());
+  else
+    std::printf("sweep %s rank %d/%d: %zu run, %zu skipped (finished before), %zu failed, %.1f s -> %s/sweep.csv\n",
               sweep_path.c_str(), opt.rank.rank, opt.rank.size, o.ran, o.skipped, o.failed, o.seconds, out.c_str());
   return o.failed > 0 ? 4 : 0;
 }
@@ -106,6 +131,10 @@ int main(int argc, char** argv) {
   sw->add_option("--out", sweep_out, "output directory (default out/sweeps/<sweep name>)");
   sw->add_flag("--quiet", sweep_quiet, "no progress on stderr");
   sw->add_flag("--estimate", sweep_estimate, "print the estimated cost of every point and stop");
+  bool sweep_list = false;
+  long sweep_point = -1;
+  sw->add_flag("--list", sweep_list, "print every point: index, folder, model, Mn, seed, state in --out, estimate; stop");
+  sw->add_option("--point", sweep_point, "run point K of the grid alone (0-based, as --list numbers them)");
   int sweep_rank = 0, sweep_ranks = 0;
   sw->add_option("--rank", sweep_rank, "run the share of rank R (0-based) of --ranks K; default: from mpirun, else all");
   sw->add_option("--ranks", sweep_ranks, "number of shares the grid is split into (round-robin)");
@@ -120,7 +149,8 @@ int main(int argc, char** argv) {
     if (*run) return run_command(scene, sets, out, quiet, resume, checkpoint_seconds);
     if (*exp) return export_lammps(exp_scene, exp_sets, exp_out);
     if (*cr) return criterion_command(cr_path, cr_thresholds);
-    if (*sw) return sweep_command(sweep_file, sweep_out, sweep_quiet, sweep_estimate, sweep_rank, sweep_ranks);
+    if (*sw) return sweep_command(sweep_file, sweep_out, sweep_quiet, sweep_estimate, sweep_list, sweep_rank, sweep_ranks,
+                                   sweep_point);
   } catch (const mrf::InputError& e) {
     std::fprintf(stderr, "mrf: error: %s\n", e.what());
     return 2;

@@ -161,6 +161,20 @@ TEST(Sweep, KilledSweepResumesAndReproduces) {
   const SweepOutcome third = run_sweep(s, out.string(), opt);
   EXPECT_EQ(third.ran, 0u);
   EXPECT_EQ(third.skipped, 2u);
+
+  // `--point K` (what a job array hands out) runs point K alone, into the
+  // same folder with the same result; a K outside the grid is refused.
+  const auto alone = std::filesystem::temp_directory_path() / "mrf_test_sweep_point";
+  std::filesystem::remove_all(alone);
+  SweepOptions one = opt;
+  one.point = 1;
+  const SweepOutcome fourth = run_sweep(s, alone.string(), one);
+  EXPECT_EQ(fourth.ran, 1u);
+  EXPECT_FALSE(std::filesystem::exists(alone / "dem_stokes/mn_0.3_seed_3"));
+  EXPECT_EQ(read_json(alone / "dem_stokes/mn_1_seed_3" / "summary.json")["stress_total"].get<double>(), stress);
+  one.point = 2;
+  EXPECT_THROW(run_sweep(s, alone.string(), one), InputError);
+  std::filesystem::remove_all(alone);
 }
 
 }  // namespace

@@ -74,7 +74,12 @@ double estimate_point_seconds(const std::string& scene_path, const std::vector<s
 
 SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const SweepOptions& opt) {
   const std::vector<SweepPoint> points = sweep_points(spec);
-  const auto mine = points_of_rank(points.size(), opt.rank.rank, opt.rank.size);
+  if (opt.point >= static_cast<long>(points.size()))
+    throw InputError("--point", std::to_string(opt.point), "",
+                     "the grid has " + std::to_string(points.size()) + " points, 0 to " +
+                         std::to_string(points.size() - 1) + " (mrf sweep FILE --list)");
+  const auto mine = opt.point >= 0 ? std::vector<std::size_t>{static_cast<std::size_t>(opt.point)}
+                                   : points_of_rank(points.size(), opt.rank.rank, opt.rank.size);
   SweepOutcome outcome;
   struct Todo {
     const SweepPoint* point;
@@ -107,9 +112,13 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
   outcome.estimated_seconds = known;
   if (!opt.quiet)
     std::fprintf(stderr,
-                 "mrf sweep: %zu points in the grid, rank %d of %d runs %zu (%zu already finished); "
+                 "mrf sweep: %zu points in the grid, %s runs %zu (%zu already finished); "
                  "estimated cost %s at %.3g particle-steps/s%s\n",
-                 points.size(), opt.rank.rank, opt.rank.size, mine.size(), outcome.skipped,
+                 points.size(),
+                 (opt.point >= 0 ? "--point " + std::to_string(opt.point)
+                                 : "rank " + std::to_string(opt.rank.rank) + " of " + std::to_string(opt.rank.size))
+                     .c_str(),
+                 mine.size(), outcome.skipped,
                  format_seconds(known).c_str(), opt.cost_rate,
                  unknown ? (" (+" + std::to_string(unknown) + " points not estimable)").c_str() : "");
 
