@@ -250,6 +250,21 @@ TEST(SceneInput, BadOverridesNameTheSetOption) {
   EXPECT_PRED_FORMAT2(testing::IsSubstring, "only one of drive.mason", both);
   const std::string no_eq = error_of(k_scene, {"drive.mason"});
   EXPECT_PRED_FORMAT2(testing::IsSubstring, "--set drive.mason", no_eq);
+  // found by test_fuzz_scene: an empty key, and a NUL that cut the message short
+  EXPECT_EQ(error_of(k_scene, {"=0"}), "key '--set' = =0: expected section.key=value: the key before '=' is empty");
+  EXPECT_EQ(error_of(k_scene, {""}).rfind("--set : key '--set': expected section.key=value", 0), 0u);
+  const std::string nul = error_of(k_scene, {std::string("drive.strai\0=1", 14)});
+  EXPECT_PRED_FORMAT2(testing::IsSubstring, "drive.strai\\x00", nul);
+}
+
+// Found by test_fuzz_scene: an extreme viscosity overflowed the shear rate
+// derived from Mn to inf (or flushed it to 0), and the scene was accepted.
+TEST(SceneInput, DerivedDriveOutOfRangeIsRefusedNamingTheMasonNumber) {
+  for (const char* eta : {"fluid.viscosity=1e-320", "fluid.viscosity=1e308"}) {
+    const std::string e = error_of(k_scene, {eta});
+    EXPECT_PRED_FORMAT2(testing::IsSubstring, "key 'drive.mason'", e);
+    EXPECT_PRED_FORMAT2(testing::IsSubstring, "gives shear rate (1/s) =", e);
+  }
 }
 
 TEST(SceneInput, LoadsAFileAndNamesAMissingOne) {

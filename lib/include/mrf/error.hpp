@@ -18,11 +18,28 @@ class InputError : public std::runtime_error {
   InputError at(const std::string& where) const { return InputError(key_, value_, where, why_); }
 
  private:
+  // Control characters of the user's text (a NUL would cut the message
+  // short where it is printed) are shown as \xNN.
+  static std::string printable(const std::string& t) {
+    static const char hex[] = "0123456789abcdef";
+    std::string s;
+    for (const char ch : t) {
+      const auto u = static_cast<unsigned char>(ch);
+      if (u >= 0x20 && u != 0x7f) {
+        s += ch;
+      } else {
+        s += "\\x";
+        s += hex[u >> 4];
+        s += hex[u & 15];
+      }
+    }
+    return s;
+  }
   static std::string format(const std::string& key, const std::string& value,
                             const std::string& where, const std::string& why) {
-    std::string s = where.empty() ? std::string() : where + ": ";
-    s += "key '" + key + "'";
-    if (!value.empty()) s += " = " + value;
+    std::string s = where.empty() ? std::string() : printable(where) + ": ";
+    s += "key '" + printable(key) + "'";
+    if (!value.empty()) s += " = " + printable(value);
     s += ": " + why;
     return s;
   }

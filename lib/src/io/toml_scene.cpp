@@ -258,9 +258,11 @@ Value override_value(const std::string& raw, const std::string& where) {
 void apply_override(Given& given, const std::string& text) {
   const std::string where = "--set " + text;
   const auto eq = text.find('=');
-  if (eq == std::string::npos) throw InputError(text, "", where, "expected section.key=value");
+  if (eq == std::string::npos)
+    throw InputError(trim(text).empty() ? "--set" : text, "", where, "expected section.key=value");
   const std::string key(trim(std::string_view(text).substr(0, eq)));
   const std::string raw(trim(std::string_view(text).substr(eq + 1)));
+  if (key.empty()) throw InputError("--set", text, "", "expected section.key=value: the key before '=' is empty");
   if (!find_spec(key)) throw InputError(key, raw, where, unknown_why(key, false, false));
   // drive.mason and drive.shear_rate are alternatives: an override replaces
   // the file's choice, unless the magnetisation is to follow from both.
@@ -399,6 +401,26 @@ void fill_drive(C& c, const Given& given) {
                                   : std::numeric_limits<double>::infinity();
 }
 
+// The quantity fill_drive derived must be usable: finite and positive (an
+// extreme viscosity or magnetisation can overflow it to inf or flush it to 0).
+void check_drive(const LoadedScene& s, const Given& given) {
+  const C& c = s.config;
+  const auto fail = [&](const char* key, const char* what, double value) {
+    std::ostringstream why;
+    why << "gives " << what << " = " << value << " with fluid.viscosity = " << c.viscosity
+        << " Pa s (Mn = 9 eta gdot / (2 mu0 M^2)): outside what a run can use";
+    const auto it = given.find(key);
+    throw InputError(key, it == given.end() ? "" : it->second.text, s.locate(key), why.str());
+  };
+  if (c.vary == MasonBy::magnetization) {
+    if (!(std::isfinite(c.magnetization) && c.magnetization > 0)) fail("drive.mason", "magnetization (A/m)", c.magnetization);
+  } else if (given.count("drive.mason")) {
+    if (!(std::isfinite(c.shear_rate) && c.shear_rate > 0)) fail("drive.mason", "shear rate (1/s)", c.shear_rate);
+  } else if (c.magnetization > 0 && !(std::isfinite(c.mason) && c.mason > 0)) {
+    fail("drive.shear_rate", "Mason number", c.mason);
+  }
+}
+
 }  // namespace
 
 std::string LoadedScene::locate(const std::string& key) const {
@@ -416,6 +438,7 @@ LoadedScene parse_scene(std::string_view toml_text, const std::string& source_na
   require_keys(s, given);
   validate(s, given);
   fill_drive(s.config, given);
+  check_drive(s, given);
   return s;
 }
 
