@@ -48,7 +48,7 @@ int export_lammps(const std::string& scene_path, const std::vector<std::string>&
 }
 
 int sweep_command(const std::string& sweep_path, std::string out, bool quiet, bool estimate_only, bool list, int rank,
-                  int ranks, long point) {
+                  int ranks, long point, double checkpoint_seconds) {
   const mrf::SweepSpec spec = mrf::load_sweep(sweep_path);
   if (out.empty()) out = "out/sweeps/" + std::filesystem::path(sweep_path).stem().string();
   mrf::SweepOptions opt;
@@ -62,6 +62,9 @@ int sweep_command(const std::string& sweep_path, std::string out, bool quiet, bo
   if (point >= 0 && ranks > 0)
     throw mrf::InputError("--point", std::to_string(point), "", "runs one point; leave out --rank/--ranks");
   opt.point = point;
+  if (!(checkpoint_seconds >= 0))
+    throw mrf::InputError("--checkpoint-every", std::to_string(checkpoint_seconds), "", "must be >= 0 (0 = none)");
+  opt.checkpoint_seconds = checkpoint_seconds;
   if (list) {
     // index, folder, state and estimate of every point: what a job array or
     // GNU parallel needs to hand `--point K` out
@@ -135,6 +138,9 @@ int main(int argc, char** argv) {
   long sweep_point = -1;
   sw->add_flag("--list", sweep_list, "print every point: index, folder, model, Mn, seed, state in --out, estimate; stop");
   sw->add_option("--point", sweep_point, "run point K of the grid alone (0-based, as --list numbers them)");
+  double sweep_checkpoint = 60;
+  sw->add_option("--checkpoint-every", sweep_checkpoint, "wall seconds between a point's checkpoints (0 = none)")
+      ->capture_default_str();
   int sweep_rank = 0, sweep_ranks = 0;
   sw->add_option("--rank", sweep_rank, "run the share of rank R (0-based) of --ranks K; default: from mpirun, else all");
   sw->add_option("--ranks", sweep_ranks, "number of shares the grid is split into (round-robin)");
@@ -150,13 +156,19 @@ int main(int argc, char** argv) {
     if (*exp) return export_lammps(exp_scene, exp_sets, exp_out);
     if (*cr) return criterion_command(cr_path, cr_thresholds);
     if (*sw) return sweep_command(sweep_file, sweep_out, sweep_quiet, sweep_estimate, sweep_list, sweep_rank, sweep_ranks,
-                                   sweep_point);
+                                   sweep_point, sweep_checkpoint);
   } catch (const mrf::InputError& e) {
     std::fprintf(stderr, "mrf: error: %s\n", e.what());
     return 2;
+  } catch (const mrf::CheckpointError& e) {
+    std::fprintf(stderr, "mrf: checkpoint refused: %s\n", e.what());
+    return 3;
   } catch (const mrf::NumericalError& e) {
     std::fprintf(stderr, "\nmrf: numerical failure: %s\n", e.what());
     return 3;
+  } catch (const std::exception& e) {  // I/O and the like: a message, not a terminate()
+    std::fprintf(stderr, "mrf: error: %s\n", e.what());
+    return 1;
   }
   return 0;
 }

@@ -52,4 +52,12 @@ class NumericalError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// A checkpoint that cannot be trusted (damaged, truncated, foreign, of
+// another format version) or cannot be resumed from (its time series is
+// gone): the run refuses it rather than continuing from damaged state.
+class CheckpointError : public NumericalError {
+ public:
+  using NumericalError::NumericalError;
+};
+
 }  // namespace mrf

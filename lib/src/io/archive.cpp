@@ -56,12 +56,12 @@ ArchiveReader::ArchiveReader(std::string path) : path_(std::move(path)) {
   std::ifstream in(path_, std::ios::binary);
   std::error_code ec;
   const auto size = std::filesystem::file_size(path_, ec);
-  if (!in || ec) throw std::runtime_error("cannot read checkpoint " + path_);
+  if (!in || ec) throw CheckpointError("cannot read checkpoint " + path_);
   bytes_.resize(size);
   in.read(bytes_.data(), static_cast<std::streamsize>(size));
-  if (static_cast<std::uintmax_t>(in.gcount()) != size) throw std::runtime_error("cannot read checkpoint " + path_);
+  if (static_cast<std::uintmax_t>(in.gcount()) != size) throw CheckpointError("cannot read checkpoint " + path_);
 
-  const auto refuse = [&](const std::string& why) { throw NumericalError(path_ + ": " + why); };
+  const auto refuse = [&](const std::string& why) { throw CheckpointError(path_ + ": " + why); };
   const std::size_t n = bytes_.size();
   // A file cut inside the magic word still starts with a prefix of it.
   if (std::string_view(bytes_).substr(0, k_archive_magic.size()) != k_archive_magic.substr(0, n))
@@ -107,7 +107,7 @@ std::size_t ArchiveReader::count(std::size_t element_bytes) {
 }
 
 void ArchiveReader::past_end(const std::string& field) const {
-  throw NumericalError(path_ + ": truncated checkpoint: reading " + field + " at payload byte " +
+  throw CheckpointError(path_ + ": truncated checkpoint: reading " + field + " at payload byte " +
                        std::to_string(pos_ - k_archive_header_bytes) + " of " +
                        std::to_string(end_ - k_archive_header_bytes) +
                        " (this build reads more fields than the writer put)");
@@ -115,7 +115,7 @@ void ArchiveReader::past_end(const std::string& field) const {
 
 void ArchiveReader::expect_end() const {
   if (remaining() != 0)
-    throw NumericalError(path_ + ": corrupt checkpoint: " + std::to_string(remaining()) +
+    throw CheckpointError(path_ + ": corrupt checkpoint: " + std::to_string(remaining()) +
                          " payload bytes left unread (this build reads fewer fields than the writer put)");
 }
 

@@ -189,6 +189,16 @@ bool RunFiles::open(LoopState& st, bool with_frames, const LoadModel& load_model
     std::filesystem::create_directories(opt_.out_dir);
     const std::string ts = opt_.out_dir + "/timeseries.csv", fr = opt_.out_dir + "/frames.xyz";
     if (resumed) {  // drop rows written after the checkpoint, then append
+      const auto need = [&](const std::string& file, std::uintmax_t bytes) {
+        std::error_code ec;
+        const std::uintmax_t have = std::filesystem::file_size(file, ec);
+        if (ec || have < bytes)
+          throw CheckpointError("cannot resume from " + checkpoint_ + ": " + file +
+                                (ec ? " is missing" : " has " + std::to_string(have) + " bytes") + ", the checkpoint was written after " +
+                                std::to_string(bytes) + " of them; the rows before it are lost: remove the checkpoint to start over");
+      };
+      need(ts, st.ts_bytes);
+      if (with_frames) need(fr, st.frames_bytes);
       std::filesystem::resize_file(ts, st.ts_bytes);
       series.open(ts, std::ios::app);
     } else {

@@ -136,6 +136,7 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
       ro.out_dir = dir;
       ro.quiet = true;
       ro.resume = true;  // a point killed mid-run continues from its last checkpoint
+      ro.checkpoint_seconds = opt.checkpoint_seconds;
       const RunSummary s = run_scene(t.scene, ro);
       ++outcome.ran;
       if (!opt.quiet)
