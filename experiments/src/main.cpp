@@ -13,6 +13,7 @@
 #include "mrf/scene/build_model.hpp"
 #include "mrf/scene/run.hpp"
 #include "mrf/study/sweep.hpp"
+#include "mrf/version.hpp"
 
 namespace {
 
@@ -108,6 +109,7 @@ int sweep_command(const std::string& sweep_path, std::string out, bool quiet, bo
 
 int main(int argc, char** argv) {
   CLI::App app{"mrf: magnetorheological fluid in a shear cell (DEM, DEM-SPH)"};
+  app.set_version_flag("--version", std::string("mrf ") + mrf::version() + " (git " + mrf::git_revision() + ")");
   app.require_subcommand(1);
   auto* run = app.add_subcommand("run", "run one scene and write summary.json and timeseries.csv");
   std::string scene, out;

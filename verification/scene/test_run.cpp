@@ -9,6 +9,8 @@
 // strain 0.3 (warm-up 0.1), about 2500 steps, 1-2 s each.
 #include <gtest/gtest.h>
 
+#include "mrf/version.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <bit>
@@ -117,6 +119,10 @@ TEST(RunOutput, SummaryJsonHasEveryKeyOfTheDesign) {
   const RunSummary& s = r.summary;
   EXPECT_EQ(j["model"], "dem_stokes");
   EXPECT_EQ(j["version"], MRF_VERSION);
+  // the git revision the binary was built from (cmake/revision.cmake)
+  ASSERT_TRUE(j.contains("git_revision"));
+  EXPECT_EQ(j["git_revision"], git_revision());
+  EXPECT_FALSE(j["git_revision"].get<std::string>().empty());
   EXPECT_EQ(j["strain"].get<double>(), k_strain);
   EXPECT_EQ(j["warmup_strain"].get<double>(), k_warmup);
   EXPECT_EQ(j["n_particles"].get<long>(), static_cast<long>(particle_count(r.scene.config)));

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "mrf/scene/run.hpp"
+#include "mrf/version.hpp"
 
 namespace mrf {
 
@@ -57,7 +58,8 @@ std::string summary_json(const RunSummary& s) {
   j["fluid_density"] = s.fluid_density;  // kg/m^3
   j["seed"] = s.seed;
   for (const auto& [key, value] : s.extra) j[key] = value;
-  j["version"] = MRF_VERSION;
+  j["version"] = version();
+  j["git_revision"] = git_revision();
   return j.dump(2);
 }
 
