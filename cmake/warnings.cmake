@@ -9,6 +9,9 @@ if(MRF_NATIVE)
   target_compile_options(mrf_flags INTERFACE -march=native)
 endif()
 if(MRF_SANITIZE)
-  target_compile_options(mrf_flags INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer)
-  target_link_options(mrf_flags INTERFACE -fsanitize=address,undefined)
+  # undefined behaviour stops the test that hit it (instead of a message in
+  # the output of a test that passes, which ctest does not show)
+  target_compile_options(mrf_flags INTERFACE -fsanitize=address,undefined -fno-sanitize-recover=undefined
+                                             -fno-omit-frame-pointer)
+  target_link_options(mrf_flags INTERFACE -fsanitize=address,undefined -fno-sanitize-recover=undefined)
 endif()

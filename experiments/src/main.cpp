@@ -162,6 +162,9 @@ int main(int argc, char** argv) {
   } catch (const mrf::InputError& e) {
     std::fprintf(stderr, "mrf: error: %s\n", e.what());
     return 2;
+  } catch (const mrf::OutputError& e) {
+    std::fprintf(stderr, "\nmrf: output failed: %s\n", e.what());
+    return 5;
   } catch (const mrf::CheckpointError& e) {
     std::fprintf(stderr, "mrf: checkpoint refused: %s\n", e.what());
     return 3;

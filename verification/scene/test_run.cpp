@@ -17,7 +17,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -356,6 +358,32 @@ TEST(RunIntegratorChoice, SmallSceneIsBoundByHertzContactWithVerletExp) {
   const auto od = dem_limits(p, r.scene.config.gap, IntegratorId::overdamped);
   EXPECT_GT(smallest(ve), smallest(od));
   EXPECT_EQ(r.summary.dt, r.scene.config.dt_safety * smallest(ve));
+}
+
+}  // namespace
+}  // namespace mrf
+
+namespace mrf {
+namespace {
+
+// A full disk (the time series goes to /dev/full, which refuses every write
+// with ENOSPC): the run stops at the first row it cannot write, with an
+// OutputError naming the file, the step and the system's reason, and leaves
+// no summary.json that would mark it finished.
+TEST(RunOutput, AFullDiskStopsTheRunNamingTheFile) {
+  if (!std::filesystem::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  const mrf::test::TempDir dir("full_disk");
+  std::filesystem::create_symlink("/dev/full", dir.path() / "timeseries.csv");
+  const LoadedScene s = mrf::test::scene({});
+  try {
+    run_scene(s, RunOptions{dir.path().string(), true});
+    ADD_FAILURE() << "the run went on with a full disk";
+  } catch (const OutputError& e) {
+    const std::string w = e.what();
+    EXPECT_NE(w.find("timeseries.csv at step"), std::string::npos) << w;
+    EXPECT_NE(w.find(std::strerror(ENOSPC)), std::string::npos) << w;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "summary.json"));
 }
 
 }  // namespace

@@ -175,6 +175,21 @@ TEST(Sweep, KilledSweepResumesAndReproduces) {
   one.point = 2;
   EXPECT_THROW(run_sweep(s, alone.string(), one), InputError);
   std::filesystem::remove_all(alone);
+
+  // A full disk at the second point (its time series goes to /dev/full):
+  // the sweep stops with an OutputError, the first point stays finished and
+  // the second resumable (no failure.json, which would mark it done).
+  if (std::filesystem::exists("/dev/full")) {
+    const auto full = std::filesystem::temp_directory_path() / "mrf_test_sweep_full";
+    std::filesystem::remove_all(full);
+    std::filesystem::create_directories(full / "dem_stokes/mn_1_seed_3");
+    std::filesystem::create_symlink("/dev/full", full / "dem_stokes/mn_1_seed_3/timeseries.csv");
+    EXPECT_THROW(run_sweep(s, full.string(), opt), OutputError);
+    EXPECT_TRUE(point_finished((full / "dem_stokes/mn_0.3_seed_3").string()));
+    EXPECT_FALSE(std::filesystem::exists(full / "dem_stokes/mn_1_seed_3/failure.json"));
+    EXPECT_FALSE(point_finished((full / "dem_stokes/mn_1_seed_3").string()));
+    std::filesystem::remove_all(full);
+  }
 }
 
 }  // namespace

@@ -52,6 +52,15 @@ class NumericalError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Writing a run's output failed (a full disk, a directory that cannot be
+// written): the run stops at once, naming the file and the system's reason;
+// what was written completely before (finished points, the last checkpoint,
+// which is replaced atomically) stays as it was.
+class OutputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 // A checkpoint that cannot be trusted (damaged, truncated, foreign, of
 // another format version) or cannot be resumed from (its time series is
 // gone): the run refuses it rather than continuing from damaged state.

@@ -1,5 +1,9 @@
 #include "mrf/scene/run_series.hpp"
 
+#include <cerrno>
+#include <cstring>
+#include <sstream>
+
 #include <omp.h>
 
 #include <algorithm>
@@ -188,6 +192,7 @@ bool RunFiles::open(LoopState& st, bool with_frames, const LoadModel& load_model
   if (!opt_.out_dir.empty()) {
     std::filesystem::create_directories(opt_.out_dir);
     const std::string ts = opt_.out_dir + "/timeseries.csv", fr = opt_.out_dir + "/frames.xyz";
+    errno = 0;
     if (resumed) {  // drop rows written after the checkpoint, then append
       const auto need = [&](const std::string& file, std::uintmax_t bytes) {
         std::error_code ec;
@@ -206,18 +211,34 @@ bool RunFiles::open(LoopState& st, bool with_frames, const LoadModel& load_model
       write_series_header(series);
     }
     series.precision(10);
+    if (!series) throw OutputError("cannot write " + ts + ": " + std::strerror(errno));
     if (with_frames) {
       if (resumed) std::filesystem::resize_file(fr, st.frames_bytes);
       frames.open(fr, resumed ? std::ios::app : std::ios::out);
+      if (!frames) throw OutputError("cannot write " + fr + ": " + std::strerror(errno));
     }
   }
   start_ = last_checkpoint_ = std::chrono::steady_clock::now();
   return resumed;
 }
 
+void RunFiles::check_written(std::ofstream& f, const std::string& path, long step) {
+  errno = 0;
+  f.flush();
+  if (f) return;
+  std::ostringstream m;
+  m << "write failed: " << path << " at step " << step << ": " << std::strerror(errno)
+    << "; the run stops (its last checkpoint, if any, is intact: --resume continues from it once there is room)";
+  throw OutputError(m.str());
+}
+
 void RunFiles::end_row(const LoopState& st, long n, double strain, bool more, const SaveModel& save_model) {
   const auto now = std::chrono::steady_clock::now();
   ++rows_since_checkpoint_;
+  // every row reaches the file at once, so a full disk stops the run at the
+  // row it hit, not silently at the end
+  if (series.is_open()) check_written(series, opt_.out_dir + "/timeseries.csv", n);
+  if (frames.is_open()) check_written(frames, opt_.out_dir + "/frames.xyz", n);
   const bool due = opt_.checkpoint_every_rows > 0
                        ? rows_since_checkpoint_ >= opt_.checkpoint_every_rows
                        : opt_.checkpoint_seconds > 0 &&

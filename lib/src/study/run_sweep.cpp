@@ -142,6 +142,10 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
       if (!opt.quiet)
         std::fprintf(stderr, "           stress_total = %.5g +- %.2g Pa, drift z = %.2f\n", s.stress_total.mean,
                      s.stress_total.err, s.stress_total.drift_z);
+    } catch (const OutputError&) {
+      // a full disk or an unwritable folder: stop the sweep, and leave the
+      // point resumable (no failure.json, which would mark it done)
+      throw;
     } catch (const std::runtime_error& e) {  // NumericalError, or an InputError only the run can see
       ++outcome.failed;
       std::filesystem::create_directories(dir);

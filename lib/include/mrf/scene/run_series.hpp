@@ -131,6 +131,8 @@ class RunFiles {
   std::ofstream series, frames;  // open when out_dir is set (frames when asked for)
 
  private:
+  // flushes f and throws OutputError naming path and the system error if the write failed
+  void check_written(std::ofstream& f, const std::string& path, long step);
   RunOptions opt_;
   std::string checkpoint_, fingerprint_;
   std::chrono::steady_clock::time_point start_, last_checkpoint_;
