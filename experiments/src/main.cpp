@@ -12,6 +12,7 @@
 #include "mrf/io/lammps_data.hpp"
 #include "mrf/scene/build_model.hpp"
 #include "mrf/scene/run.hpp"
+#include "mrf/io/atomic_file.hpp"
 #include "mrf/study/sweep.hpp"
 #include "mrf/version.hpp"
 
@@ -48,8 +49,8 @@ int export_lammps(const std::string& scene_path, const std::vector<std::string>&
   return 0;
 }
 
-int sweep_command(const std::string& sweep_path, std::string out, bool quiet, bool estimate_only, bool list, int rank,
-                  int ranks, long point, double checkpoint_seconds) {
+int sweep_command(const std::string& sweep_path, std::string out, bool quiet, bool estimate_only, bool list, bool collect,
+                  int rank, int ranks, long point, double checkpoint_seconds) {
   const mrf::SweepSpec spec = mrf::load_sweep(sweep_path);
   if (out.empty()) out = "out/sweeps/" + std::filesystem::path(sweep_path).stem().string();
   mrf::SweepOptions opt;
@@ -66,6 +67,15 @@ int sweep_command(const std::string& sweep_path, std::string out, bool quiet, bo
   if (!(checkpoint_seconds >= 0))
     throw mrf::InputError("--checkpoint-every", std::to_string(checkpoint_seconds), "", "must be >= 0 (0 = none)");
   opt.checkpoint_seconds = checkpoint_seconds;
+  if (collect) {  // sweep.csv from the finished points, nothing run (while other ranks still work)
+    const auto points = mrf::sweep_points(spec);
+    std::size_t done = 0;
+    for (const auto& p : points) done += mrf::point_finished((std::filesystem::path(out) / p.dir).string()) ? 1 : 0;
+    std::filesystem::create_directories(out);
+    mrf::write_file_atomic((std::filesystem::path(out) / "sweep.csv").string(), mrf::sweep_csv(points, out));
+    std::printf("%zu of %zu points finished -> %s/sweep.csv\n", done, points.size(), out.c_str());
+    return 0;
+  }
   if (list) {
     // index, folder, state and estimate of every point: what a job array or
     // GNU parallel needs to hand `--point K` out
@@ -138,6 +148,8 @@ int main(int argc, char** argv) {
   sw->add_flag("--estimate", sweep_estimate, "print the estimated cost of every point and stop");
   bool sweep_list = false;
   long sweep_point = -1;
+  bool sweep_collect = false;
+  sw->add_flag("--collect", sweep_collect, "write sweep.csv from the finished points in --out and stop (runs nothing)");
   sw->add_flag("--list", sweep_list, "print every point: index, folder, model, Mn, seed, state in --out, estimate; stop");
   sw->add_option("--point", sweep_point, "run point K of the grid alone (0-based, as --list numbers them)");
   double sweep_checkpoint = 60;
@@ -157,8 +169,8 @@ int main(int argc, char** argv) {
     if (*run) return run_command(scene, sets, out, quiet, resume, checkpoint_seconds);
     if (*exp) return export_lammps(exp_scene, exp_sets, exp_out);
     if (*cr) return criterion_command(cr_path, cr_thresholds);
-    if (*sw) return sweep_command(sweep_file, sweep_out, sweep_quiet, sweep_estimate, sweep_list, sweep_rank, sweep_ranks,
-                                   sweep_point, sweep_checkpoint);
+    if (*sw) return sweep_command(sweep_file, sweep_out, sweep_quiet, sweep_estimate, sweep_list, sweep_collect, sweep_rank,
+                                   sweep_ranks, sweep_point, sweep_checkpoint);
   } catch (const mrf::InputError& e) {
     std::fprintf(stderr, "mrf: error: %s\n", e.what());
     return 2;
