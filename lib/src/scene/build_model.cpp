@@ -95,8 +95,8 @@ CoupledTimeStep choose_coupled_time_step(const LoadedScene& scene, const DemPara
   // implicit too: one SPH step per particle step instead of several.
   t.fluid_limits = stability_limits(fluid, SphImplicit::viscosity);
   const double viscous = coupled_viscous_limit(fluid, eps_min);
-  const double dem_bound = inertialess ? smallest(dem_limits(p, c.gap, IntegratorId::implicit)) : 0.0;
-  if (inertialess && c.dt_safety * smallest(t.fluid_limits) < (c.dt ? *c.dt : dem_bound)) {
+  t.dem_limits = dem_limits(p, c.gap, inertialess ? IntegratorId::implicit : IntegratorId::verlet_exp);
+  if (inertialess && c.dt_safety * smallest(t.fluid_limits) < (c.dt ? *c.dt : smallest(t.dem_limits))) {
     s.sph = SphImplicit::pressure_viscosity;
     t.fluid_limits = stability_limits(fluid, s.sph);
   } else if (inertialess && k_implicit_viscosity_gain * viscous < smallest(t.fluid_limits)) {
@@ -107,7 +107,6 @@ CoupledTimeStep choose_coupled_time_step(const LoadedScene& scene, const DemPara
   }
   const StabilityLimit& bf = binding(t.fluid_limits);
   if (inertialess) {
-    t.dem_limits = dem_limits(p, c.gap, IntegratorId::implicit);
     const StabilityLimit& bd = binding(t.dem_limits);
     if (c.dt && *c.dt > bd.dt) refuse_dt_above(scene, *c.dt, bd, "implicit coupled step");
     s.dt_max = c.dt ? *c.dt : bd.dt;
@@ -117,7 +116,6 @@ CoupledTimeStep choose_coupled_time_step(const LoadedScene& scene, const DemPara
     s.implicit.order = c.implicit_order;
     return t;
   }
-  t.dem_limits = dem_limits(p, c.gap, IntegratorId::verlet_exp);
   if (c.dt && *c.dt > bf.dt) refuse_dt_above(scene, *c.dt, bf, "SPH step of the coupled models");
   s.dt_fluid = c.dt ? *c.dt : c.dt_safety * bf.dt;
   const double dem_dt = c.dt_safety * smallest(t.dem_limits);
