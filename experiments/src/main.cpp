@@ -80,29 +80,35 @@ int sweep_command(const std::string& sweep_path, std::string out, bool quiet, bo
     // index, folder, state and estimate of every point: what a job array or
     // GNU parallel needs to hand `--point K` out
     const auto points = mrf::sweep_points(spec);
+    const mrf::PointEstimates est = mrf::estimate_points(spec, points, out, opt.cost_rate);
     std::printf("%-5s %-40s %-14s %-9s %-5s %-9s %s\n", "point", "folder", "model", "Mn", "seed", "state",
-                "estimate (s)");
+                "estimate (s; * = from the particle-steps model, no point of the model finished)");
     for (const auto& p : points) {
       const std::filesystem::path dir = std::filesystem::path(out) / p.dir;
       const char* state = std::filesystem::exists(dir / "summary.json")   ? "finished"
                           : std::filesystem::exists(dir / "failure.json") ? "failed"
                           : std::filesystem::exists(dir / "checkpoint.bin") ? "started"
                                                                               : "todo";
-      std::printf("%-5zu %-40s %-14s %-9g %-5llu %-9s %.3g\n", p.index, p.dir.c_str(), p.model.c_str(), p.mason,
-                  static_cast<unsigned long long>(p.seed), state,
-                  mrf::estimate_point_seconds(spec.scene_path, p.sets, opt.cost_rate));
+      std::printf("%-5zu %-40s %-14s %-9g %-5llu %-9s %.3g%s\n", p.index, p.dir.c_str(), p.model.c_str(), p.mason,
+                  static_cast<unsigned long long>(p.seed), state, est.seconds[p.index],
+                  est.calibrated[p.index] ? "" : " *");
     }
     return 0;
   }
   if (estimate_only) {
     const auto points = mrf::sweep_points(spec);
+    const mrf::PointEstimates est = mrf::estimate_points(spec, points, out, opt.cost_rate);
     double total = 0;
+    std::size_t model_only = 0;
     for (const auto& p : points) {
-      const double e = mrf::estimate_point_seconds(spec.scene_path, p.sets, opt.cost_rate);
-      std::printf("%-40s estimated %.3g s\n", p.dir.c_str(), e);
+      const double e = est.seconds[p.index];
+      std::printf("%-40s estimated %.3g s%s\n", p.dir.c_str(), e, est.calibrated[p.index] ? "" : " *");
       if (e == e) total += e;
+      model_only += est.calibrated[p.index] ? 0 : 1;
     }
-    std::printf("total %.3g s (%.3g min) on one core at %.3g particle-steps/s\n", total, total / 60, opt.cost_rate);
+    std::printf("total %.3g s (%.3g h) on one core; %zu points (*) from the particle-steps model at %.3g "
+                "particle-steps/s, the rest from the finished points in %s\n",
+                total, total / 3600, model_only, opt.cost_rate, out.c_str());
     return 0;
   }
   const mrf::SweepOutcome o = mrf::run_sweep(spec, out, opt);

@@ -162,6 +162,22 @@ TEST(Sweep, KilledSweepResumesAndReproduces) {
   EXPECT_EQ(third.ran, 0u);
   EXPECT_EQ(third.skipped, 2u);
 
+  // Estimates calibrated by the finished points: a finished point its own
+  // wall time; a new Mn of the same model the nearest finished point's
+  // seconds per strain unit times its strain.
+  const SweepSpec wider = parse_sweep(
+      "[sweep]\nscene = \"small_dem_stokes.toml\"\nmodels = [\"dem_stokes\"]\nmason = [0.3, 1.0, 3.0]\nseeds = [3]\n"
+      "set = [\"drive.strain=0.6\", \"drive.warmup_strain=0.2\"]\n",
+      "tiny.toml", k_scenes);
+  const auto pts = sweep_points(wider);
+  const PointEstimates est = estimate_points(wider, pts, out.string(), 1e6);
+  ASSERT_EQ(est.seconds.size(), 3u);
+  EXPECT_TRUE(est.calibrated[0] && est.calibrated[1] && est.calibrated[2]);
+  EXPECT_EQ(est.seconds[1], read_json(p1 / "summary.json")["wall_seconds"].get<double>());
+  EXPECT_DOUBLE_EQ(est.seconds[2], read_json(p1 / "summary.json")["seconds_per_strain"].get<double>() * 0.6);
+  const PointEstimates fresh = estimate_points(wider, pts, (out / "nothing_here").string(), 1e6);
+  EXPECT_FALSE(fresh.calibrated[2]);
+
   // `--point K` (what a job array hands out) runs point K alone, into the
   // same folder with the same result; a K outside the grid is refused.
   const auto alone = std::filesystem::temp_directory_path() / "mrf_test_sweep_point";

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
 
@@ -72,6 +73,51 @@ double estimate_point_seconds(const std::string& scene_path, const std::vector<s
   }
 }
 
+PointEstimates estimate_points(const SweepSpec& spec, const std::vector<SweepPoint>& points, const std::string& out_dir,
+                               double cost_rate) {
+  struct Measured {
+    std::string model;
+    double log_mn, per_strain, wall;
+  };
+  std::vector<Measured> done(points.size(), Measured{"", 0, -1, -1});
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const auto path = std::filesystem::path(out_dir) / points[k].dir / "summary.json";
+    if (!std::filesystem::exists(path)) continue;
+    try {
+      std::ifstream in(path);
+      const nlohmann::json j = nlohmann::json::parse(in);
+      done[k] = {points[k].model, std::log(points[k].mason), j.at("seconds_per_strain").get<double>(),
+                 j.at("wall_seconds").get<double>()};
+    } catch (const std::exception&) {  // an unreadable summary calibrates nothing
+    }
+  }
+  PointEstimates e;
+  e.seconds.resize(points.size());
+  e.calibrated.assign(points.size(), 0);
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    if (done[k].wall >= 0) {
+      e.seconds[k] = done[k].wall;
+      e.calibrated[k] = 1;
+      continue;
+    }
+    const Measured* near = nullptr;
+    for (const Measured& m : done)
+      if (m.per_strain > 0 && m.model == points[k].model &&
+          (!near || std::abs(m.log_mn - std::log(points[k].mason)) < std::abs(near->log_mn - std::log(points[k].mason))))
+        near = &m;
+    if (near) {
+      try {
+        e.seconds[k] = near->per_strain * load_scene(spec.scene_path, points[k].sets).config.strain;
+        e.calibrated[k] = 1;
+        continue;
+      } catch (const InputError&) {
+      }
+    }
+    e.seconds[k] = estimate_point_seconds(spec.scene_path, points[k].sets, cost_rate);
+  }
+  return e;
+}
+
 SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const SweepOptions& opt) {
   const std::vector<SweepPoint> points = sweep_points(spec);
   if (opt.point >= static_cast<long>(points.size()))
@@ -87,6 +133,7 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
     double estimate;
   };
   std::vector<Todo> todo;
+  const PointEstimates calibrated = estimate_points(spec, points, out_dir, opt.cost_rate);
   for (std::size_t i : mine) {
     const SweepPoint& p = points[i];
     if (point_finished((std::filesystem::path(out_dir) / p.dir).string())) {
@@ -95,12 +142,12 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
     }
     LoadedScene scene = load_scene(spec.scene_path, p.sets);  // input errors stop the sweep here
     validate_point_fluid(p, scene);                             // and those of the fluid of a coupled model
-    double est = std::numeric_limits<double>::quiet_NaN();
-    try {
-      est = estimate_seconds(scene, opt.cost_rate);
-    } catch (const InputError&) {
-      // not estimable (e.g. a time-step rule of a model the estimate does not know); run it anyway
-    }
+    double est = calibrated.calibrated[i] ? calibrated.seconds[i] : std::numeric_limits<double>::quiet_NaN();
+    if (!calibrated.calibrated[i]) try {
+        est = estimate_seconds(scene, opt.cost_rate);
+      } catch (const InputError&) {
+        // not estimable (e.g. a time-step rule of a model the estimate does not know); run it anyway
+      }
     todo.push_back({&p, std::move(scene), est});
   }
   double known = 0;

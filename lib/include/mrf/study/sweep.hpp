@@ -96,6 +96,19 @@ struct SweepOutcome {
 // time step cannot be estimated for the model.
 double estimate_point_seconds(const std::string& scene_path, const std::vector<std::string>& sets, double cost_rate);
 
+// Estimates of every point, calibrated by the points already finished under
+// out_dir: a finished point's own wall time; an unfinished one, the
+// seconds_per_strain of the finished point of the same model nearest in
+// log Mn, times its strain (the particle-steps estimate, which is blind to
+// the implicit schemes' step sizes, only where no point of the model has
+// finished). `calibrated[k]` says which of the two an estimate is.
+struct PointEstimates {
+  std::vector<double> seconds;
+  std::vector<char> calibrated;
+};
+PointEstimates estimate_points(const SweepSpec& spec, const std::vector<SweepPoint>& points, const std::string& out_dir,
+                               double cost_rate);
+
 // Runs this rank's unfinished points one after another into out_dir/<point.dir>
 // (every scene is loaded and validated before the first run, and so is the
 // fluid of every SPH point against its box, as the coupled run checks it: an
