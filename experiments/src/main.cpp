@@ -1,7 +1,10 @@
 // The `mrf` command line (DESIGN.md §Interfaces).
 //   mrf run SCENE.toml [--set section.key=value]... [--out DIR] [--quiet] [--resume] [--checkpoint-every S]
 //   mrf criterion SWEEP_DIR|RUN_DIR [--thresholds FILE]
-//   mrf sweep SWEEP.toml [--out DIR] [--quiet] [--estimate | --list] [--point K]   (mpirun -n K splits the points)
+//   mrf sweep SWEEP.toml [--out DIR] [--quiet] [--estimate | --list | --collect] [--point K | --rank R --ranks K]
+//             [--checkpoint-every S]   (mpirun -n K splits the points)
+// Exit status: 0 done, 2 bad input, 3 numerical failure or refused
+// checkpoint, 4 a sweep point failed, 5 output could not be written, 1 other.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -9,10 +12,10 @@
 
 #include "criterion_command.hpp"
 #include "mrf/error.hpp"
+#include "mrf/io/atomic_file.hpp"
 #include "mrf/io/lammps_data.hpp"
 #include "mrf/scene/build_model.hpp"
 #include "mrf/scene/run.hpp"
-#include "mrf/io/atomic_file.hpp"
 #include "mrf/study/sweep.hpp"
 #include "mrf/version.hpp"
 
@@ -49,25 +52,33 @@ int export_lammps(const std::string& scene_path, const std::vector<std::string>&
   return 0;
 }
 
-int sweep_command(const std::string& sweep_path, std::string out, bool quiet, bool estimate_only, bool list, bool collect,
-                  int rank, int ranks, long point, double checkpoint_seconds) {
-  const mrf::SweepSpec spec = mrf::load_sweep(sweep_path);
-  if (out.empty()) out = "out/sweeps/" + std::filesystem::path(sweep_path).stem().string();
+struct SweepArgs {
+  std::string file, out;
+  bool quiet = false, estimate = false, list = false, collect = false;
+  int rank = 0, ranks = 0;
+  long point = -1;
+  double checkpoint_seconds = 60;
+};
+
+int sweep_command(const SweepArgs& a) {
+  std::string out = a.out;
+  const mrf::SweepSpec spec = mrf::load_sweep(a.file);
+  if (out.empty()) out = "out/sweeps/" + std::filesystem::path(a.file).stem().string();
   mrf::SweepOptions opt;
-  opt.quiet = quiet;
+  opt.quiet = a.quiet;
   opt.rank = mrf::rank_from_environment();
-  if (ranks > 0) {
-    if (rank < 0 || rank >= ranks)
-      throw mrf::InputError("--rank", std::to_string(rank), "", "must be in [0, --ranks)");
-    opt.rank = {rank, ranks};
+  if (a.ranks > 0) {
+    if (a.rank < 0 || a.rank >= a.ranks)
+      throw mrf::InputError("--rank", std::to_string(a.rank), "", "must be in [0, --ranks)");
+    opt.rank = {a.rank, a.ranks};
   }
-  if (point >= 0 && ranks > 0)
-    throw mrf::InputError("--point", std::to_string(point), "", "runs one point; leave out --rank/--ranks");
-  opt.point = point;
-  if (!(checkpoint_seconds >= 0))
-    throw mrf::InputError("--checkpoint-every", std::to_string(checkpoint_seconds), "", "must be >= 0 (0 = none)");
-  opt.checkpoint_seconds = checkpoint_seconds;
-  if (collect) {  // sweep.csv from the finished points, nothing run (while other ranks still work)
+  if (a.point >= 0 && a.ranks > 0)
+    throw mrf::InputError("--point", std::to_string(a.point), "", "runs one point; leave out --rank/--ranks");
+  opt.point = a.point;
+  if (!(a.checkpoint_seconds >= 0))
+    throw mrf::InputError("--checkpoint-every", std::to_string(a.checkpoint_seconds), "", "must be >= 0 (0 = none)");
+  opt.checkpoint_seconds = a.checkpoint_seconds;
+  if (a.collect) {  // sweep.csv from the finished points, nothing run (while other ranks still work)
     const auto points = mrf::sweep_points(spec);
     std::size_t done = 0;
     for (const auto& p : points) done += mrf::point_finished((std::filesystem::path(out) / p.dir).string()) ? 1 : 0;
@@ -76,7 +87,7 @@ int sweep_command(const std::string& sweep_path, std::string out, bool quiet, bo
     std::printf("%zu of %zu points finished -> %s/sweep.csv\n", done, points.size(), out.c_str());
     return 0;
   }
-  if (list) {
+  if (a.list) {
     // index, folder, state and estimate of every point: what a job array or
     // GNU parallel needs to hand `--point K` out
     const auto points = mrf::sweep_points(spec);
@@ -95,7 +106,7 @@ int sweep_command(const std::string& sweep_path, std::string out, bool quiet, bo
     }
     return 0;
   }
-  if (estimate_only) {
+  if (a.estimate) {
     const auto points = mrf::sweep_points(spec);
     const mrf::PointEstimates est = mrf::estimate_points(spec, points, out, opt.cost_rate);
     double total = 0;
@@ -112,12 +123,12 @@ int sweep_command(const std::string& sweep_path, std::string out, bool quiet, bo
     return 0;
   }
   const mrf::SweepOutcome o = mrf::run_sweep(spec, out, opt);
-  if (point >= 0)
+  if (a.point >= 0)
     std::printf("sweep %s point %ld: %zu run, %zu skipped (finished before), %zu failed, %.1f s -> %s/sweep.csv\n",
-                sweep_path.c_str(), point, o.ran, o.skipped, o.failed, o.seconds, out.c_str());
+                a.file.c_str(), a.point, o.ran, o.skipped, o.failed, o.seconds, out.c_str());
   else
     std::printf("sweep %s rank %d/%d: %zu run, %zu skipped (finished before), %zu failed, %.1f s -> %s/sweep.csv\n",
-              sweep_path.c_str(), opt.rank.rank, opt.rank.size, o.ran, o.skipped, o.failed, o.seconds, out.c_str());
+              a.file.c_str(), opt.rank.rank, opt.rank.size, o.ran, o.skipped, o.failed, o.seconds, out.c_str());
   return o.failed > 0 ? 4 : 0;
 }
 
@@ -146,24 +157,18 @@ int main(int argc, char** argv) {
   exp->add_option("--set", exp_sets, "override one key: section.key=value (repeatable)");
   exp->add_option("--out", exp_out, "output prefix: writes PREFIX.data and PREFIX.params")->required();
   auto* sw = app.add_subcommand("sweep", "run a grid of models x Mason numbers x seeds; finished points are skipped");
-  std::string sweep_file, sweep_out;
-  bool sweep_quiet = false, sweep_estimate = false;
-  sw->add_option("sweep", sweep_file, "sweep file (TOML)")->required();
-  sw->add_option("--out", sweep_out, "output directory (default out/sweeps/<sweep name>)");
-  sw->add_flag("--quiet", sweep_quiet, "no progress on stderr");
-  sw->add_flag("--estimate", sweep_estimate, "print the estimated cost of every point and stop");
-  bool sweep_list = false;
-  long sweep_point = -1;
-  bool sweep_collect = false;
-  sw->add_flag("--collect", sweep_collect, "write sweep.csv from the finished points in --out and stop (runs nothing)");
-  sw->add_flag("--list", sweep_list, "print every point: index, folder, model, Mn, seed, state in --out, estimate; stop");
-  sw->add_option("--point", sweep_point, "run point K of the grid alone (0-based, as --list numbers them)");
-  double sweep_checkpoint = 60;
-  sw->add_option("--checkpoint-every", sweep_checkpoint, "wall seconds between a point's checkpoints (0 = none)")
+  SweepArgs sa;
+  sw->add_option("sweep", sa.file, "sweep file (TOML)")->required();
+  sw->add_option("--out", sa.out, "output directory (default out/sweeps/<sweep name>)");
+  sw->add_flag("--quiet", sa.quiet, "no progress on stderr");
+  sw->add_flag("--estimate", sa.estimate, "print the estimated cost of every point and stop");
+  sw->add_flag("--list", sa.list, "print every point: index, folder, model, Mn, seed, state in --out, estimate; stop");
+  sw->add_flag("--collect", sa.collect, "write sweep.csv from the finished points in --out and stop (runs nothing)");
+  sw->add_option("--point", sa.point, "run point K of the grid alone (0-based, as --list numbers them)");
+  sw->add_option("--checkpoint-every", sa.checkpoint_seconds, "wall seconds between a point's checkpoints (0 = none)")
       ->capture_default_str();
-  int sweep_rank = 0, sweep_ranks = 0;
-  sw->add_option("--rank", sweep_rank, "run the share of rank R (0-based) of --ranks K; default: from mpirun, else all");
-  sw->add_option("--ranks", sweep_ranks, "number of shares the grid is split into (round-robin)");
+  sw->add_option("--rank", sa.rank, "run the share of rank R (0-based) of --ranks K; default: from mpirun, else all");
+  sw->add_option("--ranks", sa.ranks, "number of shares the grid is split into (round-robin)");
   auto* cr = app.add_subcommand("criterion", "flow-curve fits, deviation from model 3 and the model-1 verdict");
   std::string cr_path, cr_thresholds;
   cr->add_option("path", cr_path, "a sweep output directory (sweep.csv) or a dem_stokes run directory (summary.json)")
@@ -175,8 +180,7 @@ int main(int argc, char** argv) {
     if (*run) return run_command(scene, sets, out, quiet, resume, checkpoint_seconds);
     if (*exp) return export_lammps(exp_scene, exp_sets, exp_out);
     if (*cr) return criterion_command(cr_path, cr_thresholds);
-    if (*sw) return sweep_command(sweep_file, sweep_out, sweep_quiet, sweep_estimate, sweep_list, sweep_collect, sweep_rank,
-                                   sweep_ranks, sweep_point, sweep_checkpoint);
+    if (*sw) return sweep_command(sa);
   } catch (const mrf::InputError& e) {
     std::fprintf(stderr, "mrf: error: %s\n", e.what());
     return 2;
