@@ -52,6 +52,12 @@ int export_lammps(const std::string& scene_path, const std::vector<std::string>&
   return 0;
 }
 
+#ifdef MRF_HAVE_MPI
+}  // namespace
+int mpi_sweep(const mrf::SweepSpec& spec, const std::string& out, const mrf::SweepOptions& opt);  // mpi/mpi_sweep.cpp
+namespace {
+#endif
+
 struct SweepArgs {
   std::string file, out;
   bool quiet = false, estimate = false, list = false, collect = false;
@@ -122,6 +128,10 @@ int sweep_command(const SweepArgs& a) {
                 total, total / 3600, model_only, opt.cost_rate, out.c_str());
     return 0;
   }
+#ifdef MRF_HAVE_MPI
+  // under mpirun (more than one rank, no explicit share): the master-worker schedule
+  if (opt.rank.size > 1 && a.ranks == 0 && a.point < 0) return mpi_sweep(spec, out, opt);
+#endif
   const mrf::SweepOutcome o = mrf::run_sweep(spec, out, opt);
   if (a.point >= 0)
     std::printf("sweep %s point %ld: %zu run, %zu skipped (finished before), %zu failed, %.1f s -> %s/sweep.csv\n",

@@ -4,6 +4,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <string>
+
+#include <unistd.h>
 
 #include "mrf/error.hpp"
 
@@ -13,7 +16,9 @@ void write_file_atomic(const std::string& path, const std::string& text) {
   // The text goes to path.tmp, which replaces path by a rename only when it
   // was written whole: a full disk or a kill leaves the old file (and no
   // partial temporary) behind.
-  const std::string tmp = path + ".tmp";
+  // the temporary is the process's own: two processes (MPI ranks, job-array
+  // tasks) rewriting sweep.csv at once must not write into one temporary
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
   errno = 0;
   {
     std::ofstream out(tmp, std::ios::trunc | std::ios::binary);

@@ -82,6 +82,7 @@ struct SweepOptions {
   RankInfo rank;            // which share of the grid this process runs
   long point = -1;          // >= 0: run this point of the grid alone (`--point K`, any scheduler), not a share
   double checkpoint_seconds = 60;  // wall seconds between a point's checkpoints (RunOptions)
+  bool write_csv = true;           // rewrite sweep.csv at the end (MPI workers leave it to rank 0)
   double cost_rate = 1e6;   // particle-steps per second assumed by the first estimate
 };
 
