@@ -19,8 +19,11 @@ inline constexpr double k_rho = 1000.0;        // kg/m^3
 inline constexpr double k_nu = k_eta / k_rho;  // m^2/s
 inline constexpr double k_t_visc = k_gap * k_gap / k_nu;  // diffusion time L^2/nu (s)
 
-// n_across particles across the gap; shear_rate (1/s), body_force (m/s^2).
-inline FluidCell channel(int n_across, double shear_rate, double body_force, double eta = k_eta) {
+// n_across particles across the gap; shear_rate (1/s), body_force (m/s^2);
+// sound speed c0 (m/s, 0 = automatic) and lateral width in dx (>= 6 keeps
+// every pair a single periodic image).
+inline FluidCell channel(int n_across, double shear_rate, double body_force, double eta = k_eta, double c0 = 0.0,
+                         int lateral = 3) {
   const double dx = k_gap / n_across;
   FluidParams p;
   p.viscosity = eta;
@@ -28,7 +31,18 @@ inline FluidCell channel(int n_across, double shear_rate, double body_force, dou
   p.spacing = dx;
   p.shear_rate = shear_rate;
   p.body_force = body_force;
-  return build_fluid_cell(Box{k_gap, 3 * dx, 3 * dx}, p);
+  p.sound_speed = c0;
+  return build_fluid_cell(Box{k_gap, lateral * dx, lateral * dx}, p);
+}
+
+// Relative RMS difference of the fluid velocities of a against b.
+inline double velocity_difference(const FluidCell& a, const FluidCell& b) {
+  double d = 0, n = 0;
+  for (std::size_t i = 0; i < a.fluid.size(); ++i) {
+    d += (a.fluid.v[i] - b.fluid.v[i]).squaredNorm();
+    n += b.fluid.v[i].squaredNorm();
+  }
+  return std::sqrt(d / n);
 }
 
 // Exact start-up Couette profile of the cell (walls at -V, +V), x in box coordinates.

@@ -13,15 +13,6 @@ namespace {
 
 constexpr double k_gdot = 100.0;
 
-double velocity_difference(const FluidCell& a, const FluidCell& b) {
-  double d = 0, n = 0;
-  for (std::size_t i = 0; i < a.fluid.size(); ++i) {
-    d += (a.fluid.v[i] - b.fluid.v[i]).squaredNorm();
-    n += b.fluid.v[i].squaredNorm();
-  }
-  return std::sqrt(d / n);
-}
-
 TEST(SphImplicit, AgreesWithExplicitOnStartupCouette) {
   // Same dt (half the explicit viscous limit); both are first order in time.
   FluidCell e = channel(15, k_gdot, 0.0), i = channel(15, k_gdot, 0.0);

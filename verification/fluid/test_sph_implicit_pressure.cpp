@@ -18,24 +18,11 @@ namespace {
 
 constexpr double k_gdot = 100.0;
 
-// The channel of sph_channel.hpp with a given sound speed (m/s) and
-// lateral width (in dx; >= 6 keeps every pair a single periodic image).
-FluidCell channel_with(int n_across, double c0, int lateral) {
-  const double dx = k_gap / n_across;
-  FluidParams p;
-  p.viscosity = k_eta;
-  p.density = k_rho;
-  p.spacing = dx;
-  p.shear_rate = k_gdot;
-  p.sound_speed = c0;
-  return build_fluid_cell(Box{k_gap, lateral * dx, lateral * dx}, p);
-}
-
 // A channel with its particles displaced by up to 10 % of dx, random
 // velocities of the wall speed's order and, if `porous`, porosities in
 // (0.6, 1): no lattice symmetry left to hide an error.
 FluidCell disordered(bool porous, std::mt19937& rng) {
-  FluidCell c = channel_with(10, 0.0, 6);
+  FluidCell c = channel(10, k_gdot, 0.0, k_eta, 0.0, 6);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const double dx = c.params.spacing, v0 = 0.5 * k_gdot * c.box.gap;
   for (std::size_t a = 0; a < c.fluid.size(); ++a) {
@@ -117,15 +104,6 @@ TEST(SphImplicitPressure, DensityRowsAreTheFirstOrderChangeOfTheSummationDensity
   RecordProperty("remainder_order", std::to_string(order));
 }
 
-double velocity_difference(const FluidCell& a, const FluidCell& b) {
-  double d = 0, n = 0;
-  for (std::size_t i = 0; i < a.fluid.size(); ++i) {
-    d += (a.fluid.v[i] - b.fluid.v[i]).squaredNorm();
-    n += b.fluid.v[i].squaredNorm();
-  }
-  return std::sqrt(d / n);
-}
-
 void run_implicit(FluidCell& c, double t, double dt) {
   while (c.time < t * (1 - 1e-12)) step_implicit(c, std::min(dt, t - c.time), SphImplicit::pressure_viscosity);
 }
@@ -159,7 +137,7 @@ TEST(SphImplicitPressure, StableFarBeyondTheAcousticLimitAndFirstOrderInTime) {
   // the viscous one) against the same scheme at 1.25x: stable, first order
   // in dt; the steady profile and wall stress exact.
   const auto run = [](double factor, double t) {
-    FluidCell c = channel_with(15, k_fast_sound, 3);
+    FluidCell c = channel(15, k_gdot, 0.0, k_eta, k_fast_sound);
     stir(c, 3);
     const double dt = factor * binding(stability_limits(c, SphImplicit::viscosity)).dt;
     run_implicit(c, t, dt);

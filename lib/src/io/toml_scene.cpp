@@ -401,24 +401,12 @@ void fill_drive(C& c, const Given& given) {
                                   : std::numeric_limits<double>::infinity();
 }
 
-// The quantity fill_drive derived must be usable: finite and positive (an
-// extreme viscosity or magnetisation can overflow it to inf or flush it to 0).
+// The quantity fill_drive derived must be usable (scene/config.hpp).
 void check_drive(const LoadedScene& s, const Given& given) {
-  const C& c = s.config;
-  const auto fail = [&](const char* key, const char* what, double value) {
-    std::ostringstream why;
-    why << "gives " << what << " = " << value << " with fluid.viscosity = " << c.viscosity
-        << " Pa s (Mn = 9 eta gdot / (2 mu0 M^2)): outside what a run can use";
-    const auto it = given.find(key);
-    throw InputError(key, it == given.end() ? "" : it->second.text, s.locate(key), why.str());
-  };
-  if (c.vary == MasonBy::magnetization) {
-    if (!(std::isfinite(c.magnetization) && c.magnetization > 0)) fail("drive.mason", "magnetization (A/m)", c.magnetization);
-  } else if (given.count("drive.mason")) {
-    if (!(std::isfinite(c.shear_rate) && c.shear_rate > 0)) fail("drive.mason", "shear rate (1/s)", c.shear_rate);
-  } else if (c.magnetization > 0 && !(std::isfinite(c.mason) && c.mason > 0)) {
-    fail("drive.shear_rate", "Mason number", c.mason);
-  }
+  const auto bad = derived_drive_problem(s.config, given.count("drive.mason") > 0);
+  if (!bad) return;
+  const auto it = given.find(bad->key);
+  throw InputError(bad->key, it == given.end() ? "" : it->second.text, s.locate(bad->key), bad->why);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "mrf/scene/config.hpp"
 
 #include <cmath>
+#include <sstream>
 
 #include "mrf/vec.hpp"
 
@@ -38,5 +39,23 @@ double magnetization_from_mason(double mason, double viscosity, double shear_rat
 }
 
 const char* to_string(MasonBy v) { return v == MasonBy::shear_rate ? "shear_rate" : "magnetization"; }
+
+std::optional<DriveProblem> derived_drive_problem(const SceneConfig& c, bool mason_given) {
+  const auto fail = [&](const char* key, const char* what, double value) {
+    std::ostringstream why;
+    why << "gives " << what << " = " << value << " with fluid.viscosity = " << c.viscosity
+        << " Pa s (Mn = 9 eta gdot / (2 mu0 M^2)): outside what a run can use";
+    return DriveProblem{key, why.str()};
+  };
+  const auto usable = [](double v) { return std::isfinite(v) && v > 0; };
+  if (c.vary == MasonBy::magnetization) {
+    if (!usable(c.magnetization)) return fail("drive.mason", "magnetization (A/m)", c.magnetization);
+  } else if (mason_given) {
+    if (!usable(c.shear_rate)) return fail("drive.mason", "shear rate (1/s)", c.shear_rate);
+  } else if (c.magnetization > 0 && !usable(c.mason)) {
+    return fail("drive.shear_rate", "Mason number", c.mason);
+  }
+  return std::nullopt;
+}
 
 }  // namespace mrf

@@ -70,4 +70,13 @@ double mason_from_shear_rate(double shear_rate, double viscosity, double magneti
 double shear_rate_from_mason(double mason, double viscosity, double magnetization);
 double magnetization_from_mason(double mason, double viscosity, double shear_rate);
 
+// Whether the drive quantity derived from the others (M with drive.vary =
+// "magnetization", gdot from a given Mn, else Mn) is finite and positive: an
+// extreme viscosity or magnetisation can overflow it to inf or flush it to 0.
+// The key to blame and why, or nothing.
+struct DriveProblem {
+  std::string key, why;
+};
+std::optional<DriveProblem> derived_drive_problem(const SceneConfig& c, bool mason_given);
+
 }  // namespace mrf
