@@ -2,7 +2,7 @@
 //   mrf run SCENE.toml [--set section.key=value]... [--out DIR] [--quiet] [--resume] [--checkpoint-every S]
 //   mrf criterion SWEEP_DIR|RUN_DIR [--thresholds FILE]
 //   mrf sweep SWEEP.toml [--out DIR] [--quiet] [--estimate | --list | --collect] [--point K | --rank R --ranks K]
-//             [--checkpoint-every S]   (mpirun -n K splits the points)
+//             [--checkpoint-every S] [--archive DIR]   (mpirun -n K: master-worker schedule)
 // Exit status: 0 done, 2 bad input, 3 numerical failure or refused
 // checkpoint, 4 a sweep point failed, 5 output could not be written, 1 other.
 #include <CLI/CLI.hpp>
@@ -54,13 +54,14 @@ int export_lammps(const std::string& scene_path, const std::vector<std::string>&
 
 #ifdef MRF_HAVE_MPI
 }  // namespace
-int mpi_sweep(const mrf::SweepSpec& spec, const std::string& out, const mrf::SweepOptions& opt);  // mpi/mpi_sweep.cpp
+int mpi_sweep(const mrf::SweepSpec& spec, const std::string& out, const mrf::SweepOptions& opt,
+              const std::vector<std::string>& point_command);  // mpi/mpi_sweep.cpp
 namespace {
 #endif
 
 struct SweepArgs {
-  std::string file, out;
-  bool quiet = false, estimate = false, list = false, collect = false;
+  std::string file, out, archive;
+  bool quiet = false, estimate = false, list = false, collect = false, no_csv = false;
   int rank = 0, ranks = 0;
   long point = -1;
   double checkpoint_seconds = 60;
@@ -84,6 +85,10 @@ int sweep_command(const SweepArgs& a) {
   if (!(a.checkpoint_seconds >= 0))
     throw mrf::InputError("--checkpoint-every", std::to_string(a.checkpoint_seconds), "", "must be >= 0 (0 = none)");
   opt.checkpoint_seconds = a.checkpoint_seconds;
+  opt.archive = a.archive;
+  opt.write_csv = !a.no_csv;
+  if (!a.archive.empty() && (a.collect || a.list || a.estimate))  // a run restores its own share (run_sweep)
+    mrf::report_archive(mrf::restore_from_archive(spec, mrf::sweep_points(spec), out, a.archive), a.archive, a.quiet);
   if (a.collect) {  // sweep.csv from the finished points, nothing run (while other ranks still work)
     const auto points = mrf::sweep_points(spec);
     std::size_t done = 0;
@@ -130,7 +135,14 @@ int sweep_command(const SweepArgs& a) {
   }
 #ifdef MRF_HAVE_MPI
   // under mpirun (more than one rank, no explicit share): the master-worker schedule
-  if (opt.rank.size > 1 && a.ranks == 0 && a.point < 0) return mpi_sweep(spec, out, opt);
+  if (opt.rank.size > 1 && a.ranks == 0 && a.point < 0) {
+    // a worker runs each point as `mrf sweep FILE --point J` in a child process, so that a point that dies
+    // (OOM killer, a crash) is reported and the sweep goes on
+    std::vector<std::string> cmd{"mrf", "sweep", a.file, "--out", out, "--quiet", "--no-csv", "--checkpoint-every",
+                                 std::to_string(a.checkpoint_seconds)};
+    if (!a.archive.empty()) cmd.insert(cmd.end(), {"--archive", a.archive});
+    return mpi_sweep(spec, out, opt, cmd);
+  }
 #endif
   const mrf::SweepOutcome o = mrf::run_sweep(spec, out, opt);
   if (a.point >= 0)
@@ -174,6 +186,10 @@ int main(int argc, char** argv) {
   sw->add_flag("--estimate", sa.estimate, "print the estimated cost of every point and stop");
   sw->add_flag("--list", sa.list, "print every point: index, folder, model, Mn, seed, state in --out, estimate; stop");
   sw->add_flag("--collect", sa.collect, "write sweep.csv from the finished points in --out and stop (runs nothing)");
+  sw->add_option("--archive", sa.archive,
+                 "folder of finished points' summary.json (committed): restored into --out first, added to as points "
+                 "finish; an entry of an edited scene is ignored");
+  sw->add_flag("--no-csv", sa.no_csv, "do not rewrite sweep.csv at the end (concurrent --point runs: --collect once)");
   sw->add_option("--point", sa.point, "run point K of the grid alone (0-based, as --list numbers them)");
   sw->add_option("--checkpoint-every", sa.checkpoint_seconds, "wall seconds between a point's checkpoints (0 = none)")
       ->capture_default_str();

@@ -57,6 +57,7 @@ std::string summary_json(const RunSummary& s) {
   j["viscosity"] = s.viscosity;          // Pa s, the carrier fluid's (mrf criterion reads it)
   j["fluid_density"] = s.fluid_density;  // kg/m^3
   j["seed"] = s.seed;
+  j["scene_id"] = s.scene_id;
   for (const auto& [key, value] : s.extra) j[key] = value;
   j["version"] = version();
   j["git_revision"] = git_revision();

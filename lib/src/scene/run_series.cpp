@@ -13,6 +13,7 @@
 
 #include "mrf/error.hpp"
 #include "mrf/io/atomic_file.hpp"
+#include "mrf/io/checksum.hpp"
 #include "mrf/observe/block_average.hpp"
 #include "mrf/observe/steady_state.hpp"
 #include "mrf/observe/stress.hpp"
@@ -89,6 +90,7 @@ RunSummary scene_summary(const SceneConfig& c) {
   s.fluid_density = c.fluid_density;
   s.seed = c.seed;
   s.threads = omp_get_max_threads();
+  s.scene_id = scene_id(c);
   return s;
 }
 
@@ -167,6 +169,12 @@ std::string scene_fingerprint(const SceneConfig& c) {
   out += std::string(to_string(c.model)) + ";" + to_string(c.integrator) + ";" + std::to_string(c.seed) + ";" +
          std::to_string(c.threads) + ";" + std::to_string(c.implicit_order) + ";" + std::to_string(c.every) + ";" + std::to_string(c.frames);
   return out;
+}
+
+std::string scene_id(const SceneConfig& c) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "%08x", static_cast<unsigned>(crc32(scene_fingerprint(c))));
+  return buf;
 }
 
 RunFiles::RunFiles(const RunOptions& opt, const SceneConfig& c)

@@ -65,6 +65,16 @@ std::string format_seconds(double s) {
 
 }  // namespace
 
+void report_archive(const ArchiveSync& sync, const std::string& archive_dir, bool quiet) {
+  if (quiet) return;
+  if (sync.restored > 0)
+    std::fprintf(stderr, "mrf sweep: %zu finished points restored from the archive %s\n", sync.restored,
+                 archive_dir.c_str());
+  for (const std::string& d : sync.stale)
+    std::fprintf(stderr, "mrf sweep: archive entry %s/%s is for another scene (scene_id differs): ignored, the point runs\n",
+                 archive_dir.c_str(), d.c_str());
+}
+
 double estimate_point_seconds(const std::string& scene_path, const std::vector<std::string>& sets, double cost_rate) {
   try {
     return estimate_seconds(load_scene(scene_path, sets), cost_rate);
@@ -133,6 +143,11 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
     double estimate;
   };
   std::vector<Todo> todo;
+  if (!opt.archive.empty()) {
+    std::vector<SweepPoint> share;
+    for (std::size_t i : mine) share.push_back(points[i]);
+    report_archive(restore_from_archive(spec, share, out_dir, opt.archive), opt.archive, opt.quiet);
+  }
   const PointEstimates calibrated = estimate_points(spec, points, out_dir, opt.cost_rate);
   for (std::size_t i : mine) {
     const SweepPoint& p = points[i];
@@ -186,6 +201,7 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
       ro.checkpoint_seconds = opt.checkpoint_seconds;
       const RunSummary s = run_scene(t.scene, ro);
       ++outcome.ran;
+      if (!opt.archive.empty()) archive_point(*t.point, out_dir, opt.archive);
       if (!opt.quiet)
         std::fprintf(stderr, "           stress_total = %.5g +- %.2g Pa, drift z = %.2f\n", s.stress_total.mean,
                      s.stress_total.err, s.stress_total.drift_z);

@@ -49,6 +49,7 @@ struct RunSummary {
   double viscosity = 0, fluid_density = 0;  // carrier fluid: Pa s, kg/m^3
   std::uint64_t seed = 0;
   int threads = 1;
+  std::string scene_id;  // CRC-32 (8 hex digits) of scene_fingerprint: which scene this measured (mrf sweep --archive)
   std::map<std::string, double> extra;  // model-specific keys, written into summary.json as they are
 };
 

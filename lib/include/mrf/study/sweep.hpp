@@ -84,6 +84,7 @@ struct SweepOptions {
   double checkpoint_seconds = 60;  // wall seconds between a point's checkpoints (RunOptions)
   bool write_csv = true;           // rewrite sweep.csv at the end (MPI workers leave it to rank 0)
   double cost_rate = 1e6;   // particle-steps per second assumed by the first estimate
+  std::string archive;      // non-empty: a sweep archive (below), restored from first, added to as points finish
 };
 
 struct SweepOutcome {
@@ -118,5 +119,28 @@ PointEstimates estimate_points(const SweepSpec& spec, const std::vector<SweepPoi
 // skipped. Progress and an estimate of the time left go to stderr. At the
 // end out_dir/sweep.csv is rewritten (atomically) from every finished point.
 SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const SweepOptions& opt);
+
+// A sweep archive (`mrf sweep FILE --archive DIR`): the summary.json of every
+// finished point, in the layout of the sweep output
+// (DIR/<model>/mn_<Mn>_seed_<s>/summary.json), small enough to commit, so that
+// a sweep longer than one working period survives the loss of its output
+// folder (a new machine, a scratch file system that is purged). An entry
+// stands for a point only while its scene_id equals that of the point's scene
+// as the sweep file now defines it: an edited scene, rule or override makes
+// the entry stale, and a stale entry is reported and left alone (never used,
+// never overwritten until the point has run again). A code change that moves
+// the physics without changing the scene is not detected: clear the archive
+// then (its entries carry the git revision that wrote them).
+struct ArchiveSync {
+  std::size_t restored = 0;  // entries copied into the output (points now finished there)
+  std::vector<std::string> stale;  // point folders whose entry is for another scene
+};
+ArchiveSync restore_from_archive(const SweepSpec& spec, const std::vector<SweepPoint>& points,
+                                 const std::string& out_dir, const std::string& archive_dir);
+// Copies a finished point's summary.json into the archive (atomically); a
+// point without one (failed, unfinished) leaves the archive as it is.
+void archive_point(const SweepPoint& p, const std::string& out_dir, const std::string& archive_dir);
+// What a restore did, on stderr (nothing when quiet).
+void report_archive(const ArchiveSync& sync, const std::string& archive_dir, bool quiet);
 
 }  // namespace mrf
