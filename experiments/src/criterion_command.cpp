@@ -90,7 +90,8 @@ int criterion_command(const std::string& path, const std::string& thresholds_pat
   const mrf::SweepTable table = mrf::read_sweep_csv(path + "/sweep.csv");
   ordered_json out;
   out["mason_convention"] = "Mn = 9 eta gdot / (2 mu0 M^2)";
-  out["magnetization"] = table.magnetization;
+  if (table.magnetization > 0) out["magnetization"] = table.magnetization;
+  else out["magnetization_note"] = "varies with Mn (drive.vary = magnetization): see each point";
   out["viscosity"] = table.viscosity;
   out["fluid_density"] = table.fluid_density;
   if (!table.viscosity_note.empty()) {
@@ -105,11 +106,11 @@ int criterion_command(const std::string& path, const std::string& thresholds_pat
     std::vector<double> mn, er, ee;
     ordered_json rows = ordered_json::array();
     for (const auto& p : pts) {
-      const double k = mrf::relative_viscosity(1.0, p.mason, table.viscosity, table.magnetization);
+      const double k = mrf::relative_viscosity(1.0, p.mason, table.viscosity, p.magnetization);
       mn.push_back(p.mason);
       er.push_back(p.stress * k);
       ee.push_back(std::max(p.err, 1e-12 * std::abs(p.stress)) * k);
-      rows.push_back({{"mason", p.mason}, {"stress", p.stress}, {"err", p.err}, {"seed_scatter", p.seed_scatter},
+      rows.push_back({{"mason", p.mason}, {"magnetization", p.magnetization}, {"stress", p.stress}, {"err", p.err}, {"seed_scatter", p.seed_scatter},
                       {"within_err", p.within_err}, {"seeds", p.seeds}, {"stress_fluid", p.stress_fluid},
                       {"eta_r", er.back()}, {"eta_r_err", ee.back()}});
     }

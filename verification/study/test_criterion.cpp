@@ -80,6 +80,7 @@ TEST(Criterion, ReadsSweepCsvSkippingFailedPoints) {
   EXPECT_DOUBLE_EQ(t.viscosity, 0.1);  // no viscosity column: inferred from the dem_stokes row, and said so
   EXPECT_NE(t.viscosity_note.find("stress_fluid/shear_rate"), std::string::npos) << t.viscosity_note;
   EXPECT_DOUBLE_EQ(t.magnetization, 1e6);
+  EXPECT_DOUBLE_EQ(seed_average(t.samples.at("dem_stokes"))[0].magnetization, 1e6);
   EXPECT_DOUBLE_EQ(t.samples.at("demsph_dd")[0].stress_fluid, 20);
   EXPECT_DOUBLE_EQ(t.samples.at("dem_stokes")[0].stress_volume, 80);
   EXPECT_DOUBLE_EQ(t.samples.at("dem_stokes")[0].stokes, 0.003);
@@ -122,6 +123,37 @@ TEST(Criterion, OldSweepCsvWithoutViscosityOrModel1RowIsAClearError) {
     EXPECT_NE(msg.find("viscosity"), std::string::npos) << msg;
     EXPECT_NE(msg.find("dem_stokes"), std::string::npos) << msg;
   }
+}
+
+// The realistic path (drive.vary = magnetization): one shear rate, each Mn
+// reached by its own M. Every sample and flow point keeps its own M, so the
+// relative viscosity is tau / (eta gdot) with the sweep's one gdot; the
+// table's single magnetization is 0 (it differs between rows).
+TEST(Criterion, RealisticPathKeepsEachPointsMagnetization) {
+  const auto p = std::filesystem::temp_directory_path() / "mrf_test_sweep_realistic.csv";
+  const double eta = 0.1, gdot = 1e3, mu0 = 4e-7 * 3.14159265358979323846;
+  auto m_of = [&](double mn) { return std::sqrt(9 * eta * gdot / (2 * mu0 * mn)); };
+  std::ofstream out(p);
+  out.precision(17);
+  out << "model,mason,seed,status,shear_rate,stress_total,stress_total_err,stress_fluid,magnetization,"
+         "volume_fraction,viscosity,dir\n";
+  out << "dem_stokes,0.001,1,ok,1000,900,9,100," << m_of(1e-3) << ",0.3,0.1,a\n";
+  out << "dem_stokes,0.001,2,ok,1000,880,9,100," << m_of(1e-3) << ",0.3,0.1,b\n";
+  out << "dem_stokes,0.1,1,ok,1000,115,0.2,100," << m_of(0.1) << ",0.3,0.1,c\n";
+  out.close();
+  const SweepTable t = read_sweep_csv(p.string());
+  EXPECT_EQ(t.magnetization, 0.0);
+  const auto pts = seed_average(t.samples.at("dem_stokes"));
+  ASSERT_EQ(pts.size(), 2u);
+  for (const auto& q : pts) {
+    EXPECT_NEAR(q.magnetization, m_of(q.mason), 1e-9 * m_of(q.mason));
+    // with the point's own M the relative viscosity is tau / (eta gdot), gdot = 1000 1/s at both Mn
+    EXPECT_NEAR(relative_viscosity(q.stress, q.mason, eta, q.magnetization), q.stress / (eta * gdot),
+                1e-12 * q.stress / (eta * gdot));
+  }
+  // the one-M reading (the first row's M for every point) would be off by the ratio of the Mn: 100x here
+  EXPECT_NEAR(relative_viscosity(pts[1].stress, pts[1].mason, eta, pts[0].magnetization) /
+                  (pts[1].stress / (eta * gdot)), 1e-3 / 0.1, 1e-12);
 }
 
 }  // namespace

@@ -36,6 +36,7 @@ SweepTable read_sweep_csv(const std::string& path) {
   double inferred = 0;  // eta from a dem_stokes row, for a sweep.csv without viscosity
   std::string inferred_from;
   int line_no = 1;
+  bool first_row = true;
   while (std::getline(in, line)) {
     ++line_no;
     const auto c = split(line);
@@ -53,7 +54,10 @@ SweepTable read_sweep_csv(const std::string& path) {
       s.reynolds = std::stod(c[col["reynolds_number"]]);
     if (col.count("stress_virial_total") && !c[col["stress_virial_total"]].empty())
       s.stress_volume = std::stod(c[col["stress_virial_total"]]);
-    t.magnetization = std::stod(c[col["magnetization"]]);
+    s.magnetization = std::stod(c[col["magnetization"]]);
+    if (first_row) t.magnetization = s.magnetization;
+    else if (t.magnetization != s.magnetization) t.magnetization = 0;  // varies from row to row
+    first_row = false;
     t.volume_fraction = std::stod(c[col["volume_fraction"]]);
     if (t.viscosity == 0 && col.count("viscosity") && !c[col["viscosity"]].empty())
       t.viscosity = std::stod(c[col["viscosity"]]);

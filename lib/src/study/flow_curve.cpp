@@ -28,6 +28,7 @@ std::vector<FlowPoint> seed_average(const std::vector<StressSample>& samples) {
       p.stress_volume += s->stress_volume / n;
       p.stokes = s->stokes;
       p.reynolds = s->reynolds;
+      p.magnetization = s->magnetization;
       sum_err2 += s->err * s->err;
     }
     double ss = 0;

@@ -27,8 +27,11 @@
 
 namespace mrf {
 
-// sweep.csv rows with status ok, grouped by model (magnetization, carrier
-// viscosity and density taken from the rows; all rows of a sweep share them).
+// sweep.csv rows with status ok, grouped by model (carrier viscosity and
+// density taken from the rows; all rows of a sweep share them). Each sample
+// keeps its own magnetization: a sweep on the realistic path (drive.vary =
+// magnetization) reaches each Mn with its own M at one shear rate;
+// `magnetization` is the value all rows share, 0 when they differ.
 struct SweepTable {
   std::map<std::string, std::vector<StressSample>> samples;  // by model
   double magnetization = 0, viscosity = 0, fluid_density = 0, volume_fraction = 0;  // A/m, Pa s, kg/m^3, 1

@@ -24,6 +24,7 @@ struct StressSample {
   double stress_volume = 0;    // Pa, volume-side total: pair virial + fluid (stress_virial_total)
   double stokes = 0;           // Stokes number tau_p gdot of the run
   double reynolds = 0;         // particle Reynolds number rho_f gdot R^2 / eta of the run
+  double magnetization = 0;    // A/m: the run's own (it varies with Mn on the path drive.vary = magnetization)
 };
 
 // Seed average at one Mason number.
@@ -37,6 +38,7 @@ struct FlowPoint {
   double stress_volume = 0; // mean volume-side total (Pa)
   double stokes = 0;        // Stokes number (the same for every seed)
   double reynolds = 0;      // particle Reynolds number (the same for every seed)
+  double magnetization = 0; // A/m (the same for every seed)
   int seeds = 0;
 };
 
