@@ -1,0 +1,158 @@
+#!/usr/bin/python3
+"""The paper-scale study report (issue 13): the paper cell (150 x 50 x 120 um,
+4125 spheres) on the realistic path (one shear rate, Mn set by the
+magnetisation), the three models with seed-combined error bars, theory and
+experiment on the same axes, the small-cell study beside it, steadiness of
+every point, flow fits and cost per strain unit. Written for a sweep that is
+still running: it reports what has finished and says what has not.
+
+usage: paper_study.py SWEEP_DIR OUT_DIR [--small reports/study/flow_curves.csv]
+
+SWEEP_DIR holds sweep.csv (mrf sweep ... --collect) and criterion.json
+(mrf criterion SWEEP_DIR). Writes OUT_DIR/paper.md and its figures.
+"""
+import csv
+import json
+import math
+import os
+import sys
+from collections import defaultdict
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from study import (CHAIN_YIELD, COLOR, LABEL, MN_CONVENTION, MU0, ORDER, experiment_points,  # noqa: E402
+                   num, read_rows, save)
+
+DRIFT_Z, MSER_MAX = 3.0, 0.2  # steadiness tests of every point (DESIGN.md, issue 13)
+
+
+def arg(argv, key, default):
+    return argv[argv.index(key) + 1] if key in argv else default
+
+
+def steady(r):
+    z, d = num(r, "stress_total_drift_z"), num(r, "steady_mser_discard_fraction")
+    return abs(z) < DRIFT_Z and d < MSER_MAX
+
+
+def main(argv):
+    if len(argv) < 3:
+        print(__doc__)
+        return 2
+    sweep_dir, out = argv[1], argv[2]
+    here = os.path.dirname(os.path.abspath(__file__))
+    small_path = arg(argv, "--small", os.path.join(here, "study", "flow_curves.csv"))
+    os.makedirs(out, exist_ok=True)
+    rows = [r for r in read_rows(os.path.join(sweep_dir, "sweep.csv")) if r["status"] == "ok"]
+    crit = json.load(open(os.path.join(sweep_dir, "criterion.json")))
+    phi = crit["volume_fraction"]
+    models = [k for k in ORDER if k in crit["models"]]
+    expt = experiment_points(os.path.join(here, "..", "experiments", "data", "experiment_mrf.csv"))
+    small = defaultdict(dict)
+    if os.path.exists(small_path):
+        for r in read_rows(small_path):
+            small[r["model"]][float(r["mason"])] = (num(r, "stress_Pa"), num(r, "err_Pa"))
+    small_m = 1e6  # the small-cell study's fixed magnetisation (experiments/sweeps/default.toml)
+    gdot = num(rows[0], "shear_rate") if rows else float("nan")
+
+    # ---- stress against Mn: total and particle part -------------------------
+    fig, axs = plt.subplots(1, 2, figsize=(13, 5))
+    for k in models:
+        p = crit["models"][k]["points"]
+        s = [phi * MU0 * q["magnetization"] ** 2 for q in p]
+        x = [q["mason"] for q in p]
+        axs[0].errorbar(x, [q["stress"] / si for q, si in zip(p, s)], yerr=[q["err"] / si for q, si in zip(p, s)],
+                        fmt="o-", ms=4, capsize=3, color=COLOR[k], label=LABEL[k] + " (paper cell)")
+        axs[1].errorbar(x, [(q["stress"] - q["stress_fluid"]) / si for q, si in zip(p, s)],
+                        yerr=[q["err"] / si for q, si in zip(p, s)], fmt="o-", ms=4, capsize=3, color=COLOR[k],
+                        label=LABEL[k] + " (paper cell)")
+        if small[k]:
+            xs = sorted(small[k])
+            axs[0].errorbar(xs, [small[k][m][0] / (phi * MU0 * small_m ** 2) for m in xs],
+                            yerr=[small[k][m][1] / (phi * MU0 * small_m ** 2) for m in xs], fmt="x:", ms=4,
+                            capsize=2, color=COLOR[k], alpha=0.6, label=LABEL[k] + " (small cell, fixed M)")
+    for ax in axs:
+        ax.axhline(CHAIN_YIELD, color="k", ls="--", lw=1, label="chain model yield 0.137")
+        sources = sorted({e[0] for e in expt})
+        for src in sources:
+            vals = [v for s_, _, v in expt if s_ == src]
+            ax.plot([6e-4] * len(vals), vals, marker="s^vD<>"[sources.index(src) % 6], color="tab:red", ms=5,
+                    ls="none", label=f"experiment {src} (yield stress)")
+        ax.set(xscale="log", yscale="log", xlabel=f"Mason number ({MN_CONVENTION})", xlim=(5e-4, 20))
+    axs[0].set(ylabel="wall shear stress / (phi mu0 M^2)", title="total (particles + carrier)")
+    axs[1].set(ylabel="(stress - fluid part) / (phi mu0 M^2)", title="particle part: tau - tau_fluid")
+    axs[0].legend(fontsize=6)
+    fig.text(0.01, -0.02, f"{MN_CONVENTION}; paper cell at gdot = {gdot:g} 1/s, M = sqrt(9 eta gdot/(2 mu0 Mn)); "
+             f"phi = {phi:.2f}; error bars: max(within-run, seed scatter / sqrt(n)); experiment drawn at the left edge",
+             fontsize=7)
+    save(fig, out, "stress_vs_mason")
+
+    # ---- tables ---------------------------------------------------------------
+    lines = ["# The paper-scale study (issue 13)", "",
+             f"Paper cell (150 x 50 x 120 um, {int(num(rows[0], 'n_particles')) if rows else 0} spheres, dipole "
+             f"cut-off 4 d, Y = 200 GPa) on the realistic path: gdot = {gdot:g} 1/s for every point, "
+             "M = sqrt(9 eta gdot / (2 mu0 Mn)) (REFERENCE.md §8). Sweep: experiments/sweeps/paper_realistic.toml; "
+             "finished points are archived in reports/study/paper/points/ (mrf sweep --archive).", "",
+             "![stress](stress_vs_mason.png)", ""]
+    grid = [1e-3, 1e-2, 0.1, 1.0, 10.0]
+    done = defaultdict(int)
+    for r in rows:
+        done[(r["model"], float(r["mason"]))] += 1
+    lines += ["## Progress: finished seeds per point (of 3)", "", "| model | " + " | ".join(f"Mn {m:g}" for m in grid)
+              + " |", "|---|" + "---:|" * len(grid)]
+    for k in ORDER:
+        lines.append(f"| {k} | " + " | ".join(str(done[(k, m)]) for m in grid) + " |")
+    lines += ["", "## Stress per point (seed-combined)", "",
+              "stress/(phi mu0 M^2) with M the point's own; err = max(within-run, seed scatter/sqrt(n)); "
+              "particle part = total - fluid part (model 1: eta gdot exactly). Small cell: the default study "
+              "(375 spheres, fixed M = 1e6 A/m), same Mn; difference in combined standard errors.", "",
+              "| model | Mn | seeds | total | particle part | seed scatter / within-run | small cell total | "
+              "paper - small (sigma) |", "|---|---:|---:|---:|---:|---:|---:|---:|"]
+    for k in models:
+        for q in crit["models"][k]["points"]:
+            s = phi * MU0 * q["magnetization"] ** 2
+            t, e = q["stress"] / s, q["err"] / s
+            ratio = q["seed_scatter"] / q["within_err"] if q["within_err"] > 0 and q["seeds"] > 1 else float("nan")
+            sm = small[k].get(q["mason"])
+            if sm:
+                ss = phi * MU0 * small_m ** 2
+                st, se = sm[0] / ss, sm[1] / ss
+                cmp_ = f"{st:.4f} ± {se:.4f} | {(t - st) / math.hypot(e, se):+.1f}"
+            else:
+                cmp_ = "– | –"
+            lines.append(f"| {k} | {q['mason']:g} | {q['seeds']} | {t:.4f} ± {e:.4f} | "
+                         f"{(q['stress'] - q['stress_fluid']) / s:.4f} ± {e:.4f} | {ratio:.2f} | {cmp_} |")
+    lines += ["", f"## Steadiness of every run (drift |z| < {DRIFT_Z:g} and MSER-5 discard < {MSER_MAX:g})", "",
+              "| model | Mn | seed | strain (warm-up) | drift z | MSER discard | steady | s per strain unit |",
+              "|---|---:|---:|---:|---:|---:|---|---:|"]
+    cost = defaultdict(list)
+    for r in sorted(rows, key=lambda r: (ORDER.index(r["model"]), float(r["mason"]), int(r["seed"]))):
+        per = num(r, "wall_seconds") / (num(r, "strain") - 0)
+        cost[(r["model"], float(r["mason"]))].append(per)
+        lines.append(f"| {r['model']} | {float(r['mason']):g} | {r['seed']} | {num(r, 'strain'):g} "
+                     f"({num(r, 'warmup_strain'):g}) | {num(r, 'stress_total_drift_z'):+.2f} | "
+                     f"{num(r, 'steady_mser_discard_fraction'):.3f} | {'yes' if steady(r) else '**no**'} | "
+                     f"{per:.3g} |")
+    lines += ["", "Cost: wall seconds per strain unit of each run, one thread, on a shared 2-core machine "
+              "(the sweep ran at nice 19 beside other work: an upper bound, not a benchmark; "
+              "reports/performance/model_ratios.md has the side-by-side ratios).", ""]
+    lines += ["## Flow-curve fits (mrf criterion)", "",
+              "| model | Bingham Mn* | power-law Mn* | Delta | chi2/dof | note |", "|---|---:|---:|---:|---:|---|"]
+    for k in models:
+        b, pw = crit["models"][k]["bingham"], crit["models"][k]["power_law"]
+        note = "" if pw["ok"] else pw.get("message", "")
+        lines.append(f"| {k} | {b['mason_star']:.3g} ± {b['mason_star_err']:.2g} | "
+                     f"{pw['mason_star']:.3g} ± {pw['mason_star_err']:.2g} | {pw['exponent']:.2f} ± "
+                     f"{pw['exponent_err']:.2f} | {pw['chi2_dof']:.2g} | {note} |")
+    with open(os.path.join(out, "paper.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    print(f"-> {os.path.join(out, 'paper.md')}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
