@@ -19,28 +19,38 @@ usage() {
 benchmarks/scaling.sh: measured single-run scaling of mrf (docs/scaling.md)
 
 Options:
-  --mrf PATH   mrf binary (default: $MRF, else build/mrf)
-  --reps N     repetitions of every timing (default 2; each is reported)
-  --work DIR   scratch output directories (default ${TMPDIR:-/tmp}/mrf-scaling)
-  --quick      only the small and paper cells (about 1 minute)
-  --no-mn3     skip the model-1 runs at Mn = 1e-3
-  -h, --help   this text
+  --mrf PATH          mrf binary (default: $MRF, else build/mrf)
+  --reps N            repetitions of every timing (default 2; each is reported)
+  --work DIR          scratch output directories (default ${TMPDIR:-/tmp}/mrf-scaling)
+  --sections LIST     comma-separated, from: size, threads, long, mn3, big, ckpt
+                      (default size,threads,long,mn3; big is the 16x cell, ~100 s a run)
+  --quick             size and threads on the small and paper cells only (about 1 minute)
+  --autogroup-nice N  run in a new session whose scheduler autogroup has nice N
+                      (Linux sched_autogroup; negative N needs root). On a machine
+                      shared with niced jobs of another session, autogroup splits the
+                      CPU per session, so those jobs still take half of it and a
+                      2-thread run gets about one core; see docs/scaling.md
+  -h, --help          this text
 
 What runs (scenes from experiments/scenes/, their own Mn = 1e-2 at fixed
 magnetisation 1 MA/m, Y = 200 GPa, so `auto` picks the implicit inertialess
-scheme; warm-up 0, strain 0.5 for model 1 and 0.25 for model 3 from the
-random start):
-  model 1 (dem_stokes), 1 thread: small cell (375 spheres), paper cell
-    (4125), paper cell 2x (ly 100 um), 4x (ly 100, lz 240 um), 8x (ly 200,
-    lz 240 um); the paper cell to strain 2 (chains formed); the paper cell at
-    Mn = 1e-3 (strain 0.25)
-  model 3 (demsph_dd), 1 thread: small, paper, paper 2x, paper 4x
+scheme; warm-up 0 from the random start, strain 0.5 for model 1 and 0.25
+for model 3):
+  size:    model 1 (dem_stokes), 1 thread: small cell (375 spheres), paper
+           cell (4125), paper 2x (ly 100 um), 4x (ly 100, lz 240 um), 8x (ly 200,
+           lz 240 um); model 3 (demsph_dd): small, paper, paper 2x, paper 4x
   threads: paper cell (models 1 and 3) and paper 4x (model 1) at 1 and 2
-    threads, the 1- and 2-thread runs alternated
+           threads, the 1- and 2-thread runs alternated
+  long:    model 1, paper cell to strain 2 (chains formed)
+  mn3:     model 1, paper cell at Mn = 1e-3 (strain 0.25)
+  big:     model 1, paper 16x (ly 200, lz 480 um, 66000 spheres)
+  ckpt:    model 1, paper 4x with a checkpoint every 5 s (its peak RSS against the 4x row)
+Every other run has --checkpoint-every 0: a checkpoint holds the whole state,
+Verlet lists included, in memory while it is written, which raises the peak RSS.
 Each run's summary.json gives wall_seconds (time-step loop only), steps,
 N and the implicit iteration counts; peak RSS is the process's max RSS.
-Fits: log(time per step) = a + b log(N) over the model-1 paper-cell
-family; RSS = a + b N per model (least squares on the mean of the reps).
+Fits over the paper-cell family (1 thread, same strain, mean of the reps):
+log(time per step) and log(seconds per strain) against log(N); RSS = a + b N.
 EOF
 }
 
@@ -48,18 +58,27 @@ MRF=${MRF:-build/mrf}
 REPS=2
 WORK=${TMPDIR:-/tmp}/mrf-scaling
 QUICK=0
-MN3=1
+SECTIONS=size,threads,long,mn3
+AGNICE=""
+ARGS=("$@")
 while [ $# -gt 0 ]; do
   case "$1" in
     --mrf) MRF=$2; shift 2 ;;
     --reps) REPS=$2; shift 2 ;;
     --work) WORK=$2; shift 2 ;;
     --quick) QUICK=1; shift ;;
-    --no-mn3) MN3=0; shift ;;
+    --sections) SECTIONS=$2; shift 2 ;;
+    --autogroup-nice) AGNICE=$2; shift 2 ;;
     -h|--help) usage; exit 0 ;;
     *) echo "scaling.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
+if [ -n "$AGNICE" ] && [ -z "${MRF_SCALING_SESSION:-}" ]; then
+  # a new session gets its own autogroup; set its nice, then run this script in it
+  exec setsid env MRF_SCALING_SESSION=1 bash -c 'echo "$1" >/proc/self/autogroup && shift && exec "$@"' \
+    _ "$AGNICE" "$0" "${ARGS[@]}"
+fi
+has() { case ",$SECTIONS," in *",$1,"*) return 0 ;; *) return 1 ;; esac; }
 [ -x "$MRF" ] || { echo "scaling.sh: no mrf binary at '$MRF' (give --mrf PATH)" >&2; exit 2; }
 command -v python3 >/dev/null || { echo "scaling.sh: needs python3" >&2; exit 2; }
 mkdir -p "$WORK"
@@ -74,12 +93,14 @@ run() {
   local dir=$WORK/$label.r$rep
   local tfile=$dir.time
   rm -rf "$dir"
-  local cmd=("$MRF" run "$SC/$scene" --quiet --out "$dir" --set drive.strain="$strain"
+  local cmd=("$MRF" run "$SC/$scene" --quiet --out "$dir" --checkpoint-every "${CKPT_EVERY:-0}" --set drive.strain="$strain"
              --set drive.warmup_strain=0 --set numerics.threads="$threads" "$@")
   if [ -x /usr/bin/time ]; then
     OMP_NUM_THREADS=$threads /usr/bin/time -v -o "$tfile" "${cmd[@]}" >/dev/null
     rss=$(awk -F: '/Maximum resident set size/{gsub(/ /,"",$2); print $2}' "$tfile")
+    cpu=$(awk -F: '/Percent of CPU this job got/{gsub(/ /,"",$2); print $2}' "$tfile")
   else
+    cpu=n/a
     rss=$(OMP_NUM_THREADS=$threads python3 -c '
 import os, sys
 pid = os.fork()
@@ -90,7 +111,7 @@ _, status, ru = os.wait4(pid, 0)
 if status: sys.exit(1)
 print(ru.ru_maxrss)' "${cmd[@]}")
   fi
-  printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$label" "$model" "$cell" "$threads" "$rep" "$rss" "$dir/summary.json" >>"$RUNS"
+  printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$label" "$model" "$cell" "$threads" "$rep" "$rss" "$cpu" "$dir/summary.json" >>"$RUNS"
   echo "  done $label rep $rep (max RSS ${rss} kB)" >&2
 }
 
@@ -101,43 +122,54 @@ MN3SET=(--set drive.mason=1e-3)
 
 started=$(date -u '+%Y-%m-%d %H:%M UTC')
 load0=$(cut -d' ' -f1-3 /proc/loadavg)
+X16=(--set 'box.ly="200 um"' --set 'box.lz="480 um"')
 for rep in $(seq "$REPS"); do
   echo "repetition $rep of $REPS" >&2
-  run m1_small  dem_stokes small 1 small_dem_stokes.toml 0.5 "$rep"
-  run m1_paper  dem_stokes paper 1 paper_dem_stokes.toml 0.5 "$rep"
-  run m3_small  demsph_dd  small 1 small_demsph_dd.toml 0.5 "$rep"
-  run m3_paper  demsph_dd  paper 1 paper_demsph_dd.toml 0.25 "$rep"
-  # threads: 1 and 2 side by side, the order alternated between repetitions
-  for t in $( [ $((rep % 2)) -eq 1 ] && echo "2 1" || echo "1 2"); do
-    run m1_paper_t$t dem_stokes paper "$t" paper_dem_stokes.toml 0.5 "$rep"
-    run m3_paper_t$t demsph_dd  paper "$t" paper_demsph_dd.toml 0.25 "$rep"
-  done
+  if has size; then
+    run m1_small  dem_stokes small 1 small_dem_stokes.toml 0.5 "$rep"
+    run m1_paper  dem_stokes paper 1 paper_dem_stokes.toml 0.5 "$rep"
+    run m3_small  demsph_dd  small 1 small_demsph_dd.toml 0.5 "$rep"
+    run m3_paper  demsph_dd  paper 1 paper_demsph_dd.toml 0.25 "$rep"
+  fi
+  if has threads; then  # 1 and 2 threads side by side, the order alternated between repetitions
+    for t in $( [ $((rep % 2)) -eq 1 ] && echo "2 1" || echo "1 2"); do
+      run m1_paper_t$t dem_stokes paper "$t" paper_dem_stokes.toml 0.5 "$rep"
+      run m3_paper_t$t demsph_dd  paper "$t" paper_demsph_dd.toml 0.25 "$rep"
+    done
+  fi
   [ "$QUICK" = 1 ] && continue
-  run m1_paper2x dem_stokes paper2x 1 paper_dem_stokes.toml 0.5 "$rep" "${X2[@]}"
-  run m1_paper4x dem_stokes paper4x 1 paper_dem_stokes.toml 0.5 "$rep" "${X4[@]}"
-  run m1_paper8x dem_stokes paper8x 1 paper_dem_stokes.toml 0.5 "$rep" "${X8[@]}"
-  run m3_paper2x demsph_dd  paper2x 1 paper_demsph_dd.toml 0.25 "$rep" "${X2[@]}"
-  run m3_paper4x demsph_dd  paper4x 1 paper_demsph_dd.toml 0.25 "$rep" "${X4[@]}"
-  for t in $( [ $((rep % 2)) -eq 1 ] && echo "1 2" || echo "2 1"); do
-    run m1_paper4x_t$t dem_stokes paper4x "$t" paper_dem_stokes.toml 0.5 "$rep" "${X4[@]}"
-  done
-  run m1_paper_strain2 dem_stokes paper 1 paper_dem_stokes.toml 2 "$rep"
-  [ "$MN3" = 1 ] && run m1_paper_mn1e-3 dem_stokes paper 1 paper_dem_stokes.toml 0.25 "$rep" "${MN3SET[@]}"
+  if has size; then
+    run m1_paper2x dem_stokes paper2x 1 paper_dem_stokes.toml 0.5 "$rep" "${X2[@]}"
+    run m1_paper4x dem_stokes paper4x 1 paper_dem_stokes.toml 0.5 "$rep" "${X4[@]}"
+    run m1_paper8x dem_stokes paper8x 1 paper_dem_stokes.toml 0.5 "$rep" "${X8[@]}"
+    run m3_paper2x demsph_dd  paper2x 1 paper_demsph_dd.toml 0.25 "$rep" "${X2[@]}"
+    run m3_paper4x demsph_dd  paper4x 1 paper_demsph_dd.toml 0.25 "$rep" "${X4[@]}"
+  fi
+  if has threads; then
+    for t in $( [ $((rep % 2)) -eq 1 ] && echo "1 2" || echo "2 1"); do
+      run m1_paper4x_t$t dem_stokes paper4x "$t" paper_dem_stokes.toml 0.5 "$rep" "${X4[@]}"
+    done
+  fi
+  if has big; then run m1_paper16x dem_stokes paper16x 1 paper_dem_stokes.toml 0.5 "$rep" "${X16[@]}"; fi
+  if has ckpt; then CKPT_EVERY=5 run m1_paper4x_ckpt5s dem_stokes paper4x 1 paper_dem_stokes.toml 0.5 "$rep" "${X4[@]}"; fi
+  if has long; then run m1_paper_strain2 dem_stokes paper 1 paper_dem_stokes.toml 2 "$rep"; fi
+  if has mn3; then run m1_paper_mn1e-3 dem_stokes paper 1 paper_dem_stokes.toml 0.25 "$rep" "${MN3SET[@]}"; fi
 done
 load1=$(cut -d' ' -f1-3 /proc/loadavg)
 finished=$(date -u '+%Y-%m-%d %H:%M UTC')
 
-python3 - "$RUNS" "$MRF" "$started" "$finished" "$load0" "$load1" <<'PYEOF'
+autogroup="sched_autogroup_enabled=$(cat /proc/sys/kernel/sched_autogroup_enabled 2>/dev/null || echo n/a), this session's autogroup: $(cat /proc/self/autogroup 2>/dev/null || echo n/a)"
+python3 - "$RUNS" "$MRF" "$started" "$finished" "$load0" "$load1" "$autogroup" "${ARGS[*]}" <<'PYEOF'
 import json, math, os, subprocess, sys
-from collections import defaultdict, OrderedDict
+from collections import OrderedDict
 
-runs_file, mrf, started, finished, load0, load1 = sys.argv[1:7]
+runs_file, mrf, started, finished, load0, load1, autogroup, args = sys.argv[1:9]
 rows = []
 for line in open(runs_file):
-    label, model, cell, threads, rep, rss, path = line.rstrip("\n").split("\t")
+    label, model, cell, threads, rep, rss, cpu, path = line.rstrip("\n").split("\t")
     d = json.load(open(path))
     rows.append(dict(label=label, model=model, cell=cell, threads=int(threads), rep=int(rep),
-                     rss_kb=float(rss), **{k: d.get(k) for k in (
+                     rss_kb=float(rss), cpu=cpu, **{k: d.get(k) for k in (
                          "n_particles", "n_wall", "n_fluid", "steps", "wall_seconds", "strain",
                          "seconds_per_strain", "mason", "integrator", "neighbor_builds",
                          "implicit_newton_iterations", "implicit_linear_iterations",
@@ -149,51 +181,9 @@ def sh(cmd):
     except Exception:
         return "?"
 
-model_name = sh("lscpu | sed -n 's/^Model name: *//p' | head -1")
-print("# Single-run scaling (generated by benchmarks/scaling.sh)")
-print()
-print(f"- date: {started} to {finished}")
-print(f"- machine: nproc = {sh('nproc')}, lscpu model '{model_name}', "
-      f"load average (1, 5, 15 min) {load0} at start, {load1} at end")
-print(f"- binary: `{os.path.basename(mrf)} --version`: {sh(mrf + ' --version')}")
-print("- every run: warm-up 0 from the scene's random start, `numerics.threads` = OMP_NUM_THREADS = threads; "
-      "times are summary.json `wall_seconds` (the time-step loop), RSS is the process's max RSS")
-print()
-
-groups = OrderedDict()
-for r in rows:
-    groups.setdefault(r["label"], []).append(r)
-
-def fmt(vals, f):
-    return ", ".join(f.format(v) for v in vals)
-
-print("| run | model | cell | N free | N wall | N fluid | threads | Mn | strain | steps | wall s | ms / step | us / particle-step | s / strain | Newton / step | CG / Newton | max RSS MB |")
-print("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
-for label, rs in groups.items():
-    r0 = rs[0]
-    ms = [1e3 * r["wall_seconds"] / r["steps"] for r in rs]
-    ups = [1e6 * r["wall_seconds"] / (r["steps"] * r["n_particles"]) for r in rs]
-    nw = r0["implicit_newton_iterations"]; cg = r0["implicit_linear_iterations"]
-    newton = f"{nw / r0['steps']:.2f}" if nw else "-"
-    cgn = f"{cg / nw:.2f}" if nw else "-"
-    steps = fmt([r["steps"] for r in rs], "{}")
-    print(f"| {label} | {r0['model']} | {r0['cell']} | {r0['n_particles']} | {r0['n_wall']} | {r0['n_fluid']} | "
-          f"{r0['threads']} | {r0['mason']:g} | {r0['strain']:g} | {steps} | {fmt([r['wall_seconds'] for r in rs], '{:.2f}')} | "
-          f"{fmt(ms, '{:.2f}')} | {fmt(ups, '{:.2f}')} | {fmt([r['seconds_per_strain'] for r in rs], '{:.2f}')} | "
-          f"{newton} | {cgn} | {fmt([r['rss_kb'] / 1024 for r in rs], '{:.1f}')} |")
-print()
-print("Reps are listed in order, comma separated. Newton / step and CG / Newton are from the first rep "
-      "(`implicit_newton_iterations` / steps, `implicit_linear_iterations` / `implicit_newton_iterations`). "
-      "Integrator: " + ", ".join(sorted({f"{r['model']}: {r['integrator']}" for r in rows})) + ".")
-det = []
-for label, rs in groups.items():
-    if len(rs) > 1:
-        same = all(r["stress_total"] == rs[0]["stress_total"] and r["steps"] == rs[0]["steps"] for r in rs)
-        det.append(f"{label} {'identical' if same else 'DIFFERENT'}")
-print("Repeated runs, stress_total and steps bit for bit: " + "; ".join(det) + ".")
-print()
-
 def mean(v): return sum(v) / len(v)
+
+def fmt(vals, f): return ", ".join(f.format(v) for v in vals)
 
 def linfit(x, y):
     n = len(x); mx = mean(x); my = mean(y)
@@ -202,41 +192,89 @@ def linfit(x, y):
     se = math.sqrt(sum((yy - a - b * xx) ** 2 for xx, yy in zip(x, y)) / (n - 2) / sxx) if n > 2 else float("nan")
     return a, b, se
 
-print("## Fits")
+model_name = sh("lscpu | sed -n 's/^Model name: *//p' | head -1")
+print("# Single-run scaling (generated by benchmarks/scaling.sh)")
 print()
-fam = [g for l, g in groups.items() if l.startswith("m1_paper") and g[0]["threads"] == 1
-       and g[0]["strain"] == 0.5 and g[0]["mason"] == 0.01 and "_t" not in l]
-if len(fam) >= 2:
-    x = [math.log(g[0]["n_particles"]) for g in fam]
-    y = [math.log(mean([r["wall_seconds"] / r["steps"] for r in g])) for g in fam]
-    a, b, se = linfit(x, y)
-    ns = ", ".join(str(g[0]["n_particles"]) for g in fam)
-    print(f"- model 1, time per step ~ N^b over the paper-cell family (N = {ns}, 1 thread, mean of reps): "
-          f"b = {b:.3f} +- {se:.3f}")
-for model in ("dem_stokes", "demsph_dd"):
-    gs = [g for l, g in groups.items() if g[0]["model"] == model and g[0]["threads"] == 1 and "_t" not in l
-          and g[0]["mason"] == 0.01 and g[0]["strain"] <= 0.5]
-    if len(gs) >= 2:
-        x = [g[0]["n_particles"] for g in gs]
-        y = [mean([r["rss_kb"] for r in g]) / 1024 for g in gs]
+print(f"- command: `benchmarks/scaling.sh {args}`")
+print(f"- date: {started} to {finished}")
+print(f"- machine: nproc = {sh('nproc')}, lscpu model '{model_name}'; load average (1, 5, 15 min) "
+      f"{load0} at start, {load1} at end; {autogroup}")
+print(f"- binary: `{os.path.basename(mrf)} --version`: {sh(mrf + ' --version')}")
+print("- every run: warm-up 0 from the scene's random start, `numerics.threads` = OMP_NUM_THREADS = threads; "
+      "times are summary.json `wall_seconds` (the time-step loop), RSS the process's max RSS")
+print()
+
+groups = OrderedDict()
+for r in rows:
+    groups.setdefault(r["label"], []).append(r)
+
+print("| run | model | cell | N free | N wall | N fluid | threads | Mn | strain | steps | wall s | ms / step "
+      "| us / particle-step | s / strain | Newton / step | CG / Newton | Verlet builds / step | max RSS MB |")
+print("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+for label, rs in groups.items():
+    r0 = rs[0]
+    ms = [1e3 * r["wall_seconds"] / r["steps"] for r in rs]
+    ups = [1e6 * r["wall_seconds"] / (r["steps"] * r["n_particles"]) for r in rs]
+    nw = r0["implicit_newton_iterations"]; cg = r0["implicit_linear_iterations"]
+    newton = f"{nw / r0['steps']:.2f}" if nw else "-"
+    cgn = f"{cg / nw:.2f}" if nw else "-"
+    print(f"| {label} | {r0['model']} | {r0['cell']} | {r0['n_particles']} | {r0['n_wall']} | {r0['n_fluid']} | "
+          f"{r0['threads']} | {r0['mason']:g} | {r0['strain']:g} | {fmt([r['steps'] for r in rs], '{}')} | "
+          f"{fmt([r['wall_seconds'] for r in rs], '{:.2f}')} | {fmt(ms, '{:.2f}')} | {fmt(ups, '{:.2f}')} | "
+          f"{fmt([r['seconds_per_strain'] for r in rs], '{:.2f}')} | {newton} | {cgn} | "
+          f"{r0['neighbor_builds'] / r0['steps']:.2f} | {fmt([r['rss_kb'] / 1024 for r in rs], '{:.1f}')} |")
+print()
+print("Reps in order, comma separated. Newton / step, CG / Newton and Verlet builds / step from the first rep "
+      "(`implicit_newton_iterations` / steps, `implicit_linear_iterations` / `implicit_newton_iterations`, "
+      "`neighbor_builds` / steps). Integrator: "
+      + ", ".join(sorted({f"{r['model']}: {r['integrator']}" for r in rows})) + ".")
+det = []
+for label, rs in groups.items():
+    if len(rs) > 1:
+        same = all(r["stress_total"] == rs[0]["stress_total"] and r["steps"] == rs[0]["steps"] for r in rs)
+        det.append(f"{label} {'identical' if same else 'DIFFERENT'}")
+if det:
+    print("Repeated runs, stress_total and steps bit for bit: " + "; ".join(det) + ".")
+print()
+
+# the paper-cell family: 1 thread, Mn 1e-2, the standard strain of the model
+def family(model, strain):
+    return [g for l, g in groups.items() if g[0]["model"] == model and g[0]["cell"].startswith("paper")
+            and g[0]["threads"] == 1 and g[0]["mason"] == 0.01 and g[0]["strain"] == strain
+            and "_t" not in l and "ckpt" not in l]
+
+fits = []
+for model, strain in (("dem_stokes", 0.5), ("demsph_dd", 0.25)):
+    fam = family(model, strain)
+    if len(fam) < 2:
+        continue
+    ns = [g[0]["n_particles"] for g in fam]
+    x = [math.log(n) for n in ns]
+    for what, val in (("time per step", lambda r: r["wall_seconds"] / r["steps"]),
+                      ("seconds per strain", lambda r: r["seconds_per_strain"])):
+        y = [math.log(mean([val(r) for r in g])) for g in fam]
         a, b, se = linfit(x, y)
-        extra = ""
-        nf = [g[0]["n_fluid"] for g in gs]
-        if any(nf):
-            extra = f" (fluid particles per free sphere: {', '.join(f'{f / n:.3f}' for f, n in zip(nf, x))})"
-        print(f"- {model}, max RSS = a + b N over N = {', '.join(map(str, x))}: a = {a:.1f} MB, "
-              f"b = {1024 * 1024 * b:.0f} +- {1024 * 1024 * se:.0f} bytes per free sphere{extra}")
-print()
-print("## Threads (1 against 2, the same scene, run side by side)")
-print()
-print("| cell | model | wall s, 1 thread | wall s, 2 threads | speed-up per rep | efficiency |")
-print("|---|---|---:|---:|---:|---:|")
-for l, g in groups.items():
-    if l.endswith("_t1"):
-        g2 = groups.get(l[:-1] + "2")
-        if not g2: continue
+        fits.append(f"- {model}, {what} ~ N^b over N = {', '.join(map(str, ns))}: b = {b:.3f} +- {se:.3f}")
+    y = [mean([r["rss_kb"] for r in g]) / 1024 for g in fam]
+    a, b, se = linfit(ns, y)
+    res = ", ".join(f"{yy - a - b * n:+.1f}" for n, yy in zip(ns, y))
+    fits.append(f"- {model}, max RSS = a + b N over N = {', '.join(map(str, ns))}: a = {a:.1f} MB, "
+                f"b = {1024 * 1024 * b:.0f} +- {1024 * 1024 * se:.0f} bytes per free sphere (residuals {res} MB)")
+if fits:
+    print("## Fits (paper-cell family, 1 thread, mean of the reps; +- is the standard error)")
+    print()
+    print("\n".join(fits))
+    print()
+
+pairs = [(l, g, groups[l[:-1] + "2"]) for l, g in groups.items() if l.endswith("_t1") and (l[:-1] + "2") in groups]
+if pairs:
+    print("## Threads (1 against 2, the same scene, run side by side)")
+    print()
+    print("| cell | model | wall s, 1 thread | wall s, 2 threads | speed-up per rep | efficiency | CPU of the 2-thread runs (/usr/bin/time) |")
+    print("|---|---|---:|---:|---:|---:|---:|")
+    for l, g, g2 in pairs:
         t1 = [r["wall_seconds"] for r in g]; t2 = [r["wall_seconds"] for r in g2]
         sp = [a / b for a, b in zip(t1, t2)]
         print(f"| {g[0]['cell']} | {g[0]['model']} | {fmt(t1, '{:.2f}')} | {fmt(t2, '{:.2f}')} | "
-              f"{fmt(sp, '{:.2f}')} | {fmt([s / 2 for s in sp], '{:.0%}')} |")
+              f"{fmt(sp, '{:.2f}')} | {fmt([s / 2 for s in sp], '{:.0%}')} | {', '.join(r['cpu'] for r in g2)} |")
 PYEOF

@@ -71,7 +71,9 @@ SweepTable read_sweep_csv(const std::string& path) {
         inferred_from = path + ":" + std::to_string(line_no);
       }
     }
-    t.samples[c[col["model"]]].push_back(s);
+    // a sweep with variants: one flow curve per model and variant
+    const std::string variant = col.count("variant") ? c[col["variant"]] : "";
+    t.samples[c[col["model"]] + (variant.empty() ? "" : "@" + variant)].push_back(s);
   }
   if (t.viscosity > 0 || t.samples.empty()) return t;
   if (inferred > 0) {

@@ -3,6 +3,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -72,6 +73,46 @@ std::string mason_label(double mn) {
   return buf;
 }
 
+void parse_variants(const toml::node& variants, const std::string& source, SweepSpec& s) {
+  const auto* arr = variants.as_array();
+  if (!arr) throw InputError("variant", "", where_of(variants, source), "expected [[variant]] tables");
+  for (const auto& e : *arr) {
+    const auto* t = e.as_table();
+    if (!t) throw InputError("variant", text_of(e), where_of(e, source), "expected a table");
+    SweepVariant v;
+    for (const auto& [k, val] : *t) {
+      const std::string key(k.str());
+      if (key == "name") {
+        const auto* n = val.as_string();
+        const bool safe = n && !n->get().empty() && std::all_of(n->get().begin(), n->get().end(), [](char c) {
+          return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.' || c == '-';
+        });
+        if (!safe || n->get() == "." || n->get() == "..")
+          throw InputError("variant.name", text_of(val), where_of(val, source),
+                           "expected a folder-safe name (letters, digits, _ . -)");
+        v.name = n->get();
+      } else if (key == "set") {
+        const auto* a = val.as_array();
+        if (!a) throw InputError("variant.set", text_of(val), where_of(val, source), "expected an array of section.key=value");
+        v.set = strings(*a, "variant.set", source);
+      } else if (key == "mason") {
+        const auto* a = val.as_array();
+        if (!a || a->empty())
+          throw InputError("variant.mason", text_of(val), where_of(val, source), "expected a non-empty array");
+        for (const auto& m : *a) v.mason.push_back(positive_number(m, "variant.mason", source));
+      } else {
+        throw InputError("variant." + key, text_of(val), where_of(val, source), "unknown key");
+      }
+    }
+    if (v.name.empty()) throw InputError("variant.name", "", where_of(e, source), "missing");
+    for (const auto& other : s.variants)
+      if (other.name == v.name) throw InputError("variant.name", "\"" + v.name + "\"", where_of(e, source), "used twice");
+    if (v.mason.empty() && s.mason.empty())
+      throw InputError("variant.mason", "", where_of(e, source), "missing, and the sweep has no sweep.mason to fall back on");
+    s.variants.push_back(std::move(v));
+  }
+}
+
 }  // namespace
 
 SweepSpec parse_sweep(const std::string& toml_text, const std::string& source, const std::string& base_dir) {
@@ -82,8 +123,9 @@ SweepSpec parse_sweep(const std::string& toml_text, const std::string& source, c
     throw InputError("(syntax)", "", source + ":" + std::to_string(e.source().begin.line), std::string(e.description()));
   }
   for (const auto& [k, v] : root)
-    if (k.str() != "sweep" && k.str() != "rule")
-      throw InputError(std::string(k.str()), "", where_of(v, source), "unknown section; expected [sweep] or [[rule]]");
+    if (k.str() != "sweep" && k.str() != "rule" && k.str() != "variant")
+      throw InputError(std::string(k.str()), "", where_of(v, source),
+                       "unknown section; expected [sweep], [[rule]] or [[variant]]");
   const toml::table* sw = root["sweep"].as_table();
   if (!sw) throw InputError("sweep", "", source, "missing [sweep] table");
   SweepSpec s;
@@ -101,7 +143,8 @@ SweepSpec parse_sweep(const std::string& toml_text, const std::string& source, c
   const auto& models = need_array(*sw, "models", "sweep", source);
   s.models = strings(models, "sweep.models", source);
   check_models(s.models, models, "sweep.models", source);
-  for (const auto& e : need_array(*sw, "mason", "sweep", source)) s.mason.push_back(positive_number(e, "sweep.mason", source));
+  if (sw->get("mason") || !root.get("variant"))
+    for (const auto& e : need_array(*sw, "mason", "sweep", source)) s.mason.push_back(positive_number(e, "sweep.mason", source));
   for (const auto& e : need_array(*sw, "seeds", "sweep", source)) {
     const auto v = e.value<std::int64_t>();
     if (!v || *v < 0) throw InputError("sweep.seeds", text_of(e), where_of(e, source), "expected a non-negative integer");
@@ -136,6 +179,7 @@ SweepSpec parse_sweep(const std::string& toml_text, const std::string& source, c
       s.rules.push_back(std::move(r));
     }
   }
+  if (const toml::node* variants = root.get("variant")) parse_variants(*variants, source, s);
   return s;
 }
 
@@ -149,26 +193,33 @@ SweepSpec load_sweep(const std::string& path) {
 
 std::vector<SweepPoint> sweep_points(const SweepSpec& spec) {
   std::vector<SweepPoint> out;
+  const std::vector<SweepVariant> none{SweepVariant{}};
+  const auto& variants = spec.variants.empty() ? none : spec.variants;
   for (const auto& model : spec.models)
-    for (double mn : spec.mason)
-      for (std::uint64_t seed : spec.seeds) {
-        SweepPoint p;
-        p.index = out.size();
-        p.model = model;
-        p.mason = mn;
-        p.seed = seed;
-        p.sets = spec.set;
-        for (const auto& r : spec.rules) {
-          const bool model_ok = r.models.empty() || std::find(r.models.begin(), r.models.end(), model) != r.models.end();
-          const bool mn_ok = (r.mason_min == 0 || mn >= r.mason_min) && (r.mason_max == 0 || mn <= r.mason_max);
-          if (model_ok && mn_ok) p.sets.insert(p.sets.end(), r.set.begin(), r.set.end());
+    for (const auto& v : variants)
+      for (double mn : v.mason.empty() ? spec.mason : v.mason)
+        for (std::uint64_t seed : spec.seeds) {
+          SweepPoint p;
+          p.index = out.size();
+          p.model = model;
+          p.mason = mn;
+          p.seed = seed;
+          p.variant = v.name;
+          p.sets = spec.set;
+          for (const auto& r : spec.rules) {
+            const bool model_ok =
+                r.models.empty() || std::find(r.models.begin(), r.models.end(), model) != r.models.end();
+            const bool mn_ok = (r.mason_min == 0 || mn >= r.mason_min) && (r.mason_max == 0 || mn <= r.mason_max);
+            if (model_ok && mn_ok) p.sets.insert(p.sets.end(), r.set.begin(), r.set.end());
+          }
+          p.sets.insert(p.sets.end(), v.set.begin(), v.set.end());
+          p.sets.push_back("scene.model=\"" + model + "\"");
+          p.sets.push_back("drive.mason=" + format_number(mn));  // reads back exactly: the run and sweep.csv agree
+          p.sets.push_back("scene.seed=" + std::to_string(seed));
+          p.dir = model + "/" + (v.name.empty() ? "" : v.name + "/") + "mn_" + mason_label(mn) + "_seed_" +
+                  std::to_string(seed);
+          out.push_back(std::move(p));
         }
-        p.sets.push_back("scene.model=\"" + model + "\"");
-        p.sets.push_back("drive.mason=" + format_number(mn));  // reads back exactly: the run and sweep.csv agree
-        p.sets.push_back("scene.seed=" + std::to_string(seed));
-        p.dir = model + "/mn_" + mason_label(mn) + "_seed_" + std::to_string(seed);
-        out.push_back(std::move(p));
-      }
   return out;
 }
 
@@ -213,7 +264,7 @@ std::string sweep_csv(const std::vector<SweepPoint>& points, const std::string& 
   csv.precision(10);
   csv << "model,mason,seed,status";
   for (const char* k : numbers) csv << "," << k;
-  csv << ",integrator,dir\n";
+  csv << ",variant,integrator,dir\n";
   for (const auto& p : points) {
     const auto dir = std::filesystem::path(out_dir) / p.dir;
     nlohmann::json j;
@@ -231,7 +282,8 @@ std::string sweep_csv(const std::vector<SweepPoint>& points, const std::string& 
       csv << ",";
       if (status == "ok" && j.contains(k) && j[k].is_number()) csv << j[k].get<double>();
     }
-    csv << "," << (status == "ok" && j.contains("integrator") ? j["integrator"].get<std::string>() : "") << "," << p.dir
+    csv << "," << p.variant << "," << (status == "ok" && j.contains("integrator") ? j["integrator"].get<std::string>() : "")
+        << "," << p.dir
         << "\n";
   }
   return csv.str();

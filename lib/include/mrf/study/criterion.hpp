@@ -33,7 +33,7 @@ namespace mrf {
 // magnetization) reaches each Mn with its own M at one shear rate;
 // `magnetization` is the value all rows share, 0 when they differ.
 struct SweepTable {
-  std::map<std::string, std::vector<StressSample>> samples;  // by model
+  std::map<std::string, std::vector<StressSample>> samples;  // by model, or "model@variant" in a sweep with variants
   double magnetization = 0, viscosity = 0, fluid_density = 0, volume_fraction = 0;  // A/m, Pa s, kg/m^3, 1
   std::string viscosity_note;  // how the viscosity was found when sweep.csv has no viscosity value
 };

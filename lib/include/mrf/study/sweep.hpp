@@ -17,6 +17,13 @@
 //   mason_min = 0.5                       # matches mason >= mason_min (optional)
 //   models = ["dem_stokes"]               # matches these models (optional)
 //   set = ["drive.strain=3"]
+//   [[variant]]                           # optional: the grid runs once per variant
+//   name = "sph_fine"                     # folder-safe: letters, digits, _ . -
+//   set = ["fluid.sph_spacing='7.5 um'"]  # applied after the rules
+//   mason = [1e-2, 1.0]                   # optional: this variant's Mason numbers instead of sweep.mason
+// With variants the grid is model x variant x Mn x seed (variant after
+// model in the index order), a point's folder is <model>/<variant>/mn_..,
+// and sweep.mason may be left out when every variant gives its own.
 // Errors are InputErrors naming the key and FILE:LINE.
 #pragma once
 #include <cstdint>
@@ -33,6 +40,14 @@ struct SweepRule {
   std::vector<std::string> set;
 };
 
+// A named set of overrides the whole grid is run with (convergence in one
+// numerical choice, the conditions of a held-out design).
+struct SweepVariant {
+  std::string name;
+  std::vector<std::string> set;
+  std::vector<double> mason;  // empty: the sweep's
+};
+
 struct SweepSpec {
   std::string source;      // sweep file path (for messages)
   std::string scene_path;  // resolved base scene path
@@ -41,13 +56,15 @@ struct SweepSpec {
   std::vector<std::uint64_t> seeds;
   std::vector<std::string> set;
   std::vector<SweepRule> rules;
+  std::vector<SweepVariant> variants;  // empty: one grid, no variant folder level
 };
 
 struct SweepPoint {
-  std::size_t index = 0;          // position in the grid (model-major, then mason, then seed)
+  std::size_t index = 0;          // position in the grid (model-major, then variant, mason, seed)
   std::string model;
   double mason = 0;
   std::uint64_t seed = 0;
+  std::string variant;            // its name, empty without variants
   std::vector<std::string> sets;  // every override of this point, in order
   std::string dir;                // output folder relative to the sweep output, e.g. dem_stokes/mn_0.01_seed_1
 };
