@@ -47,6 +47,13 @@ TEST(SweepVariants, GridIsModelVariantMasonSeedWithTheVariantAfterTheRules) {
                                       "drive.mason=0.001", "scene.seed=1"};
   EXPECT_EQ(pts[0].sets, base);
   for (std::size_t i = 0; i < pts.size(); ++i) EXPECT_EQ(pts[i].index, i);
+  // a variant for some models only
+  const auto some = sweep_points(parse_sweep(
+      text("mason = [0.01]\n", "[[variant]]\nname = \"b\"\n[[variant]]\nname = \"sph\"\nmodels = [\"demsph_dd\"]\n"),
+      "v.toml", k_scenes));
+  ASSERT_EQ(some.size(), 2u + 4u);  // dem_stokes: b x 2 seeds; demsph_dd: (b + sph) x 2 seeds
+  EXPECT_EQ(some[1].dir, "dem_stokes/b/mn_0.01_seed_2");
+  EXPECT_EQ(some[4].dir, "demsph_dd/sph/mn_0.01_seed_1");
   // without variants nothing changes: no folder level, empty variant
   const auto plain = sweep_points(parse_sweep(text("mason = [1e-3, 0.01]\n", ""), "v.toml", k_scenes));
   ASSERT_EQ(plain.size(), 8u);
@@ -73,6 +80,8 @@ TEST(SweepVariants, SweepMasonMayBeLeftOutOnlyWhenEveryVariantHasItsOwn) {
                "v.toml:12");
   expect_error(text("mason = [1]\n", "[[variant]]\nname = \"a\"\nspeed = 2\n"), "variant.speed", "v.toml:12");
   expect_error(text("mason = [1]\n", "[[variant]]\nname = \"a\"\nmason = [-1]\n"), "variant.mason", "v.toml:12");
+  expect_error(text("mason = [1]\n", "[[variant]]\nname = \"a\"\nmodels = [\"demsph_stokes\"]\n"), "variant.models",
+               "v.toml:12");
 }
 
 // sweep.csv carries the variant, and the criterion reads one flow curve per

@@ -95,6 +95,14 @@ void parse_variants(const toml::node& variants, const std::string& source, Sweep
         const auto* a = val.as_array();
         if (!a) throw InputError("variant.set", text_of(val), where_of(val, source), "expected an array of section.key=value");
         v.set = strings(*a, "variant.set", source);
+      } else if (key == "models") {
+        const auto* a = val.as_array();
+        if (!a || a->empty())
+          throw InputError("variant.models", text_of(val), where_of(val, source), "expected a non-empty array");
+        v.models = strings(*a, "variant.models", source);
+        for (const auto& m : v.models)
+          if (std::find(s.models.begin(), s.models.end(), m) == s.models.end())
+            throw InputError("variant.models", "\"" + m + "\"", where_of(val, source), "not one of sweep.models");
       } else if (key == "mason") {
         const auto* a = val.as_array();
         if (!a || a->empty())
@@ -196,7 +204,8 @@ std::vector<SweepPoint> sweep_points(const SweepSpec& spec) {
   const std::vector<SweepVariant> none{SweepVariant{}};
   const auto& variants = spec.variants.empty() ? none : spec.variants;
   for (const auto& model : spec.models)
-    for (const auto& v : variants)
+    for (const auto& v : variants) {
+      if (!v.models.empty() && std::find(v.models.begin(), v.models.end(), model) == v.models.end()) continue;
       for (double mn : v.mason.empty() ? spec.mason : v.mason)
         for (std::uint64_t seed : spec.seeds) {
           SweepPoint p;
@@ -220,6 +229,7 @@ std::vector<SweepPoint> sweep_points(const SweepSpec& spec) {
                   std::to_string(seed);
           out.push_back(std::move(p));
         }
+    }
   return out;
 }
 

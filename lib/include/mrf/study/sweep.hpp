@@ -21,6 +21,7 @@
 //   name = "sph_fine"                     # folder-safe: letters, digits, _ . -
 //   set = ["fluid.sph_spacing='7.5 um'"]  # applied after the rules
 //   mason = [1e-2, 1.0]                   # optional: this variant's Mason numbers instead of sweep.mason
+//   models = ["demsph_dd"]                # optional: run with these of the sweep's models only
 // With variants the grid is model x variant x Mn x seed (variant after
 // model in the index order), a point's folder is <model>/<variant>/mn_..,
 // and sweep.mason may be left out when every variant gives its own.
@@ -46,6 +47,7 @@ struct SweepVariant {
   std::string name;
   std::vector<std::string> set;
   std::vector<double> mason;  // empty: the sweep's
+  std::vector<std::string> models;  // the models it runs with; empty: all of the sweep's
 };
 
 struct SweepSpec {
