@@ -46,7 +46,10 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
     const double strain = model.time() * c.shear_rate;
     st.max_overlap = std::max(st.max_overlap, row.max_overlap);
     if (files.series.is_open()) write_series_row(files.series, model.time(), strain, row, c.radius);
-    if (st.row_start * c.shear_rate >= c.warmup_strain * (1 - 1e-12)) st.se.push(row);  // whole rows after warm-up
+    if (st.row_start * c.shear_rate >= c.warmup_strain * (1 - 1e-12)) {  // whole rows after warm-up
+      row.clusters = cluster_stats(model.cell(), c.radius);
+      st.se.push(row);
+    }
     row = SeriesRow{};
     st.row_start = model.time();
     files.end_row(st, n, strain, running(), [&](ArchiveWriter& out) { model.save(out); });

@@ -53,6 +53,8 @@ void StressSeries::push(const SeriesRow& r) {
   diff_.push_back(tp - vm - vc);
   vir_fluid_.push_back(r.vir_fluid * k);
   vir_total_.push_back(vm + vc + r.vir_fluid * k);
+  spanning_.push_back(r.clusters.spanning_fraction);
+  wall_clusters_.push_back(r.clusters.wall_fraction);
 }
 
 Measurement StressSeries::fluid() const { return measure(fluid_); }
@@ -69,6 +71,10 @@ void StressSeries::finish(RunSummary& s) const {
   s.extra["stress_virial_total"] = vt.mean;
   s.extra["stress_virial_total_err"] = vt.err;
   s.extra["stress_virial_fluid"] = measure(vir_fluid_).mean;
+  const Measurement span = measure(spanning_);
+  s.extra["spanning_fraction"] = span.mean;
+  s.extra["spanning_fraction_err"] = span.err;
+  s.extra["wall_cluster_fraction"] = measure(wall_clusters_).mean;
   // steady-state check: the share of the averaging window MSER-5 would still
   // discard as transient (0 = steady from the end of the warm-up)
   s.extra["steady_mser_discard_fraction"] =

@@ -13,6 +13,7 @@
 
 #include "mrf/integrate/implicit_stepper.hpp"
 #include "mrf/io/archive.hpp"
+#include "mrf/observe/structure.hpp"
 #include "mrf/scene/dem_forces.hpp"
 #include "mrf/scene/run.hpp"
 #include "mrf/scene/shear_cell.hpp"
@@ -24,6 +25,7 @@ struct SeriesRow {
   double particles = 0, fluid = 0, vir_mag = 0, vir_con = 0, vir_fluid = 0, max_overlap = 0, e_dip = 0,
          e_hertz = 0;
   double n = 0;  // sum of the step weights
+  ClusterStats clusters;  // of the configuration that ends the row (observe/structure.hpp)
   // One step of weight w (1 for fixed steps, the step length for the adaptive
   // implicit scheme): the particles' pair sums, the fluid's wall stress and
   // the fluid's virial stress (Pa; eta gdot for the imposed profile of model 1).
@@ -40,6 +42,8 @@ class StressSeries {
   // stress - pair virial). The volume-side total, pair virial + fluid
   // virial, goes to extra["stress_virial_total"] (+ "_err") beside
   // extra["stress_virial_fluid"]: it must match stress_total in steady state.
+  // The structure: extra["spanning_fraction"] (+ "_err"), the share of free
+  // spheres in gap-spanning clusters, and extra["wall_cluster_fraction"].
   void finish(RunSummary& s) const;
   std::size_t size() const { return total_.size(); }
   Measurement fluid() const;
@@ -47,13 +51,15 @@ class StressSeries {
   // const StressSeries (Archive::io puts or gets each field).
   template <class Archive, class Self>
   static void serialize(Archive& ar, Self& s) {
-    ar.io(s.total_, s.particles_, s.fluid_, s.virial_, s.mag_, s.con_, s.diff_, s.vir_fluid_, s.vir_total_);
+    ar.io(s.total_, s.particles_, s.fluid_, s.virial_, s.mag_, s.con_, s.diff_, s.vir_fluid_, s.vir_total_,
+          s.spanning_, s.wall_clusters_);
   }
   void save(ArchiveWriter& a) const { serialize(a, *this); }
   void load(ArchiveReader& a) { serialize(a, *this); }
 
  private:
   std::vector<double> total_, particles_, fluid_, virial_, mag_, con_, diff_, vir_fluid_, vir_total_;
+  std::vector<double> spanning_, wall_clusters_;  // ClusterStats of each row's end
 };
 
 // The fields of summary.json that come from the scene alone (model, Mn,
