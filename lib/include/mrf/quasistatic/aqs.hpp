@@ -1,0 +1,135 @@
+// Athermal quasi-static shear (AQS) of the shear cell: the rate-independent
+// limit Mn -> 0 of the DEM model without time steps (issue 17, DESIGN.md).
+//
+// Each increment: the wall spheres are displaced by +-(gap/2) d_gamma along z
+// (the wall motion of integrate/steps.hpp, move_walls, with gdot dt = d_gamma),
+// the free particles optionally by the affine field d_gamma x (default on:
+// the standard AQS start point, it removes most of the elastic relaxation
+// the minimiser would otherwise do), then the free particles are relaxed to
+// a local minimum of the dipole + Hertz energy by FIRE 2.0
+// (quasistatic/fire.hpp) until the largest force on a free particle is below
+// force_tol F0, F0 = (pi/6) mu0 R^2 M^2 the head-to-tail dipole force at
+// contact (REFERENCE TEST 1.1). The dipole law is the shifted-force form of
+// quasistatic/shifted_dipole.hpp (continuous energy and force at the
+// cut-off); Hertz as forces/hertz.hpp, energy (2/5) k h^{5/2}. The pair loop
+// is the scene's (scene/dem_forces.hpp) with that dipole evaluator.
+//
+// At each minimum the wall stress and the virial stress (observe/stress.hpp)
+// are taken, in Pa. In static equilibrium they agree: the virial identity
+// (verification/observe/test_stress.cpp) gives wall - virial =
+// (1/V) sum_i x_i f_i,z, bounded by N (gap/2) force_tol / V at an accepted
+// minimum. A minimisation that does not converge is a NumericalError: the
+// run never continues from a non-minimum.
+#pragma once
+#include <cstddef>
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "mrf/io/toml_scene.hpp"
+#include "mrf/neighbors/verlet_list.hpp"
+#include "mrf/observe/block_average.hpp"
+#include "mrf/params.hpp"
+#include "mrf/quasistatic/fire.hpp"
+#include "mrf/quasistatic/shifted_dipole.hpp"
+#include "mrf/scene/dem_forces.hpp"
+#include "mrf/scene/shear_cell.hpp"
+
+namespace mrf {
+
+struct QuasistaticOptions {
+  double strain_increment = 1e-3;      // d_gamma per increment
+  std::optional<double> strain;        // total strain; default the scene's drive.strain
+  std::optional<double> warmup_strain; // excluded from the steady mean; default drive.warmup_strain
+  bool affine = true;                  // affine displacement d_gamma x of the free particles
+  double force_tol = 1e-6;             // accepted minimum: max |f_i| < force_tol F0
+  long max_iterations = 200000;        // FIRE iterations allowed per minimisation
+  double dipole_cutoff = 0;            // r_c of the shifted-force law (m); 0 = particles.dipole_cutoff
+  // FIRE step sizes relative to the contact time scale t_k = sqrt(m_p / k_eff),
+  // k_eff = dF/dh of Hertz at twice the contact force (a chain's tension):
+  double dt_max_over_tk = 0.4;         // semi-implicit Euler is stable below ~0.58 t_k with 6 contacts
+  double dt_start_over_tk = 0.04;
+  double max_step_over_radius = 0.05;  // largest displacement of one particle per FIRE iteration / R
+
+  // InputError naming quasistatic.<field> on a bad value.
+  void validate() const;
+};
+
+// One accepted minimum.
+struct QuasistaticPoint {
+  std::size_t increment = 0;  // 0: the minimum of the initial configuration
+  double strain = 0;
+  double stress_wall = 0;            // Pa, observe/stress.hpp wall_shear_stress
+  double stress_virial = 0;          // Pa, magnetic + contact
+  double stress_virial_magnetic = 0; // Pa
+  double stress_virial_contact = 0;  // Pa
+  double energy = 0;                 // J, shifted dipole + Hertz
+  double max_force = 0;              // N, max |f_i| over the free particles
+  double max_overlap = 0;            // m
+  long iterations = 0;               // FIRE iterations of this minimisation
+};
+
+struct QuasistaticResult {
+  // One entry per accepted minimum, increment 0 first.
+  std::vector<double> strain, stress_wall, stress_virial, stress_virial_magnetic, stress_virial_contact, energy,
+      max_force, max_overlap;
+  std::vector<long> iterations;
+  // Steady flow: the points with strain >= warmup, less the MSER-5
+  // transient (observe/steady_state.hpp), block-averaged over strain.
+  double steady_from_strain = 0;
+  BlockAverage steady_wall, steady_virial;  // Pa
+  double force_scale = 0;        // F0 (N)
+  double force_tol = 0;          // N
+  double stress_scale = 0;       // phi mu0 M^2 (Pa), for reports
+  double dipole_cutoff = 0;      // m
+  double equilibrium_bound = 0;  // N (gap/2) force_tol / V (Pa): |wall - virial| bound at a minimum
+  long force_evaluations = 0;
+  long list_builds = 0;
+  double wall_seconds = 0;
+  ShearCell final_cell;          // the last minimum
+};
+
+// The state the minimiser works on: the cell, the laws, their pair lists.
+struct QuasistaticState {
+  ShearCell cell;
+  DemPairLaws<DipoleXShiftedForce> laws;
+  DemPairLists lists;
+  ForceBuffers buffers;
+  PairSums sums;  // of the last force evaluation
+};
+
+// The laws of DemParams with the shifted-force dipole at `cutoff` (m).
+DemPairLaws<DipoleXShiftedForce> quasistatic_laws(const DemParams& p, double cutoff);
+QuasistaticState make_quasistatic_state(ShearCell cell, const DemParams& p, double cutoff);
+
+// Forces on the free particles at their current positions (wraps y, z and
+// rebuilds stale lists); sums kept in state.sums.
+void evaluate_forces(QuasistaticState& s);
+
+// Walls by +-(gap/2) d_gamma in z; with `affine`, each free particle by d_gamma x.
+void apply_strain_increment(QuasistaticState& s, double d_gamma, bool affine);
+
+// FIRE options of a scene: tolerances and steps from DemParams (see the fields above).
+FireOptions quasistatic_fire_options(const DemParams& p, const QuasistaticOptions& o);
+
+// Relax to a minimum; NumericalError (naming increment, strain, iterations,
+// max |f| and the tolerance) if FIRE stops without convergence.
+FireResult relax(QuasistaticState& s, const FireOptions& fire, std::size_t increment, double strain);
+
+// The observables of the current (relaxed) state.
+QuasistaticPoint measure(const QuasistaticState& s);
+
+// Called at every accepted minimum (progress, frames); may be empty.
+using QuasistaticObserver = std::function<void(const QuasistaticPoint&)>;
+
+// The run on a cell built by hand (tests) or from a scene. `strain` and
+// `warmup_strain` of the options must be set for the first form.
+QuasistaticResult run_quasistatic(ShearCell cell, const DemParams& p, const QuasistaticOptions& o,
+                                  const QuasistaticObserver& observer = {});
+// The cell of build_shear_cell(scene) (the builder every model uses),
+// DemParams from dem_params(scene.config); a magnetisation of 0 is refused
+// (no force scale), as is a cut-off that breaks the minimum image.
+QuasistaticResult run_quasistatic(const LoadedScene& scene, const QuasistaticOptions& o,
+                                  const QuasistaticObserver& observer = {});
+
+}  // namespace mrf
