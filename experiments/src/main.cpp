@@ -1,6 +1,8 @@
 // The `mrf` command line (DESIGN.md §Interfaces).
 //   mrf run SCENE.toml [--set section.key=value]... [--out DIR] [--quiet] [--resume] [--checkpoint-every S]
 //   mrf criterion SWEEP_DIR|RUN_DIR [--thresholds FILE]
+//   mrf quasistatic SCENE.toml [--set k=v]... [--out DIR] [--increment D] [--tol T] [--strain S] [--warmup W]
+//             [--cutoff R] [--no-affine]
 //   mrf sweep SWEEP.toml [--out DIR] [--quiet] [--estimate | --list | --collect] [--point K | --rank R --ranks K]
 //             [--checkpoint-every S] [--archive DIR]   (mpirun -n K: master-worker schedule)
 // Exit status: 0 done, 2 bad input, 3 numerical failure or refused
@@ -11,6 +13,7 @@
 #include <filesystem>
 
 #include "criterion_command.hpp"
+#include "quasistatic_command.hpp"
 #include "mrf/error.hpp"
 #include "mrf/io/atomic_file.hpp"
 #include "mrf/io/lammps_data.hpp"
@@ -201,12 +204,35 @@ int main(int argc, char** argv) {
       ->required();
   cr->add_option("--thresholds", cr_thresholds,
                  "JSON with share_10 and share_20 (e.g. experiments/criterion_thresholds.json) for verdicts");
+  auto* qs = app.add_subcommand("quasistatic", "athermal quasi-static shear: the Mn -> 0 limit, stress at energy minima");
+  std::string qs_scene, qs_out;
+  std::vector<std::string> qs_sets;
+  mrf::QuasistaticOptions qo;
+  bool qs_quiet = false, no_affine = false;
+  double qs_strain = 0, qs_warmup = -1;
+  qs->add_option("scene", qs_scene, "scene file (TOML)")->required();
+  qs->add_option("--set", qs_sets, "override one key: section.key=value (repeatable)");
+  qs->add_option("--out", qs_out, "output directory (default out/<scene name>_quasistatic)");
+  qs->add_option("--increment", qo.strain_increment, "strain increment per minimisation")->capture_default_str();
+  qs->add_option("--tol", qo.force_tol, "accepted minimum: max |f| < tol F0")->capture_default_str();
+  qs->add_option("--strain", qs_strain, "total strain (default the scene's drive.strain)");
+  qs->add_option("--warmup", qs_warmup, "strain left out of the steady mean (default drive.warmup_strain)");
+  qs->add_option("--cutoff", qo.dipole_cutoff, "shifted-force dipole cut-off in m (default particles.dipole_cutoff)");
+  qs->add_option("--max-iterations", qo.max_iterations, "FIRE iterations per minimisation")->capture_default_str();
+  qs->add_flag("--no-affine", no_affine, "free particles not displaced affinely before each minimisation");
+  qs->add_flag("--quiet", qs_quiet, "no progress on stderr");
   CLI11_PARSE(app, argc, argv);
   try {
     if (*run) return run_command(scene, sets, out, quiet, resume, checkpoint_seconds);
     if (*exp) return export_lammps(exp_scene, exp_sets, exp_out);
     if (*cr) return criterion_command(cr_path, cr_thresholds);
     if (*sw) return sweep_command(sa);
+    if (*qs) {
+      qo.affine = !no_affine;
+      if (qs_strain > 0) qo.strain = qs_strain;
+      if (qs_warmup >= 0) qo.warmup_strain = qs_warmup;
+      return quasistatic_command(qs_scene, qs_sets, qs_out, qo, qs_quiet);
+    }
   } catch (const mrf::InputError& e) {
     std::fprintf(stderr, "mrf: error: %s\n", e.what());
     return 2;

@@ -1,0 +1,33 @@
+#!/usr/bin/env python3
+"""ctest QuasistaticCli: `mrf quasistatic` on the small scene (Y = 2 GPa, five
+increments of 1e-3): exit 0, quasistatic.csv with one row per minimum (the
+initial one and five more), every minimum below the force tolerance, wall and
+virial stress equal within the static-equilibrium bound, and summary.json
+with the steady mean, its error and the scene's id.
+
+Usage: cli_check.py MRF_BINARY SCENE WORKDIR
+"""
+import csv, json, pathlib, shutil, subprocess, sys
+
+mrf, scene, work = sys.argv[1], sys.argv[2], pathlib.Path(sys.argv[3])
+shutil.rmtree(work, ignore_errors=True)
+subprocess.run([mrf, "quasistatic", scene, "--set", "contact.youngs_modulus=2e9", "--strain", "0.005", "--warmup",
+                "0.002", "--increment", "1e-3", "--out", str(work), "--quiet"], check=True)
+s = json.loads((work / "summary.json").read_text())
+rows = list(csv.DictReader((work / "quasistatic.csv").open()))
+bad = []
+if len(rows) != 6 or s["minima"] != 6:
+    bad.append(f"expected 6 minima, got {len(rows)} rows and minima = {s['minima']}")
+for r in rows:
+    if float(r["max_force"]) >= s["force_tol"]:
+        bad.append(f"strain {r['strain']}: max |f| {r['max_force']} >= tol {s['force_tol']}")
+    if abs(float(r["stress_wall"]) - float(r["stress_virial"])) > s["equilibrium_bound"]:
+        bad.append(f"strain {r['strain']}: wall {r['stress_wall']} and virial {r['stress_virial']} differ beyond "
+                   f"{s['equilibrium_bound']}")
+if abs(float(rows[-1]["strain"]) - 0.005) > 1e-12:
+    bad.append(f"last strain {rows[-1]['strain']}")
+for k in ("stress_wall", "stress_wall_err", "stress_virial", "scene_id", "stress_wall_over_phi_mu0_m2"):
+    if k not in s:
+        bad.append(f"summary.json lacks {k}")
+print("\n".join(bad) if bad else f"mrf quasistatic: {len(rows)} minima, all checks passed")
+sys.exit(1 if bad else 0)
