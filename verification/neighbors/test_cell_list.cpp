@@ -88,3 +88,22 @@ TEST(CellList, XIsNotPeriodic) {
 
 }  // namespace
 }  // namespace mrf
+
+namespace mrf {
+namespace {
+
+// The lists store 32-bit offsets: a count past 2^32 - 1 is an error that
+// names the list, never a wrapped offset.
+TEST(CellList, ListOffsetsPast32BitsAreAnErrorNotAWrap) {
+  EXPECT_EQ(checked_index(0, "pair list"), 0u);
+  EXPECT_EQ(checked_index(4294967295ull, "pair list"), 4294967295u);
+  try {
+    checked_index(4294967296ull, "pair list");
+    FAIL() << "expected std::length_error";
+  } catch (const std::length_error& e) {
+    EXPECT_NE(std::string(e.what()).find("pair list: 4294967296 entries"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace mrf

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "mrf/neighbors/cell_list.hpp"
+
 namespace mrf {
 
 void FluidResponse::set(std::size_t n_dem, const std::vector<CouplingPair>& pairs, const std::vector<double>& s,
@@ -32,7 +34,7 @@ void FluidResponse::set(std::size_t n_dem, const std::vector<CouplingPair>& pair
       }
     }
     for (std::size_t k = row; k < a_.size(); ++k) slot_[a_[k]] = -1;
-    merged[i + 1] = static_cast<std::uint32_t>(a_.size());
+    merged[i + 1] = checked_index(a_.size(), "fluid response");
   }
   start_ = std::move(merged);
   // The same entries by SPH particle (CSR over a), so that the scatter is a

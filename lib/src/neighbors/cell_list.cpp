@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 namespace mrf {
 
@@ -76,6 +78,14 @@ std::vector<IndexPair> self_pairs(const std::vector<Vec3>& pts, const Box& box, 
   return out;
 }
 
+std::uint32_t checked_index(std::size_t n, const char* what) {
+  if (n > std::numeric_limits<std::uint32_t>::max())
+    throw std::length_error(std::string(what) + ": " + std::to_string(n) +
+                            " entries exceed the 32-bit indices of the lists (at most 4294967295): the cell is too "
+                            "large for one process (docs/scaling.md)");
+  return static_cast<std::uint32_t>(n);
+}
+
 void self_pair_rows(const std::vector<Vec3>& pts, const Box& box, double cutoff, PairRows& out) {
   out.k.clear();
   out.start.assign(pts.empty() ? 0 : pts.size() + 1, 0);
@@ -92,7 +102,7 @@ void self_pair_rows(const std::vector<Vec3>& pts, const Box& box, double cutoff,
       if (j <= i) return;
       if (mi.norm2(xi, pts[j]) < rc2) out.k.push_back(j);
     });
-    out.start[i + 1] = static_cast<std::uint32_t>(out.k.size());
+    out.start[i + 1] = checked_index(out.k.size(), "pair list");
   }
 }
 

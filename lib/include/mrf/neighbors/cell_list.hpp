@@ -11,6 +11,11 @@ namespace mrf {
 
 using IndexPair = std::pair<std::uint32_t, std::uint32_t>;
 
+// A list offset or index as the 32-bit value the lists store; a count past
+// 2^32 - 1 (about 4e7 spheres at 100 list entries each, docs/scaling.md) is
+// a std::length_error naming `what`, never a silent wrap.
+std::uint32_t checked_index(std::size_t n, const char* what);
+
 // A half pair list stored by rows (CSR): the partners of point i are
 // k[start[i]], ..., k[start[i + 1] - 1], all with index > i.
 struct PairRows {
