@@ -7,25 +7,20 @@
 
 #include "mrf/error.hpp"
 #include "mrf/fluid/kernel.hpp"
+#include "mrf/io/quantity.hpp"
 
 namespace mrf {
 
 namespace {
 
-std::string num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 void require_positive(const char* key, double v) {
-  if (!(v > 0) || !std::isfinite(v)) throw InputError(key, num(v), "", "must be positive and finite");
+  if (!(v > 0) || !std::isfinite(v)) throw InputError(key, format_short(v), "", "must be positive and finite");
 }
 
 // A parameter no scene sets (the solver's own setting, or a test's): the
 // error says so instead of naming a scene key the user cannot find.
 [[noreturn]] void internal_error(const char* name, double v, const std::string& why) {
-  throw InputError(std::string("FluidParams::") + name, num(v), "",
+  throw InputError(std::string("FluidParams::") + name, format_short(v), "",
                    why + " (an internal parameter of the SPH solver, not a scene key: the code that built the "
                          "fluid set it)");
 }
@@ -45,9 +40,9 @@ void FluidParams::validate(const Box& box) const {
   if (!(h_over_dx >= 1.0 && h_over_dx <= 2.5))
     internal_error("h_over_dx", h_over_dx, "smoothing length / sph_spacing must lie in [1, 2.5]");
   if (!(sound_speed >= 0) || !std::isfinite(sound_speed))
-    throw InputError("fluid.sound_speed", num(sound_speed), "", "must be >= 0 (0 = automatic)");
+    throw InputError("fluid.sound_speed", format_short(sound_speed), "", "must be >= 0 (0 = automatic)");
   if (!std::isfinite(shear_rate))
-    throw InputError("drive.shear_rate", num(shear_rate), "", "must be finite (given, or derived from drive.mason)");
+    throw InputError("drive.shear_rate", format_short(shear_rate), "", "must be finite (given, or derived from drive.mason)");
   if (!std::isfinite(body_force)) internal_error("body_force", body_force, "body force along z must be finite");
   if (!(density_tolerance > 0 && density_tolerance < 0.1))
     internal_error("density_tolerance", density_tolerance,
@@ -61,13 +56,13 @@ void FluidParams::validate(const Box& box) const {
   for (const auto& s : sides) {
     require_positive(s.key, s.length);
     if (!is_multiple(s.length, spacing))
-      throw InputError("fluid.sph_spacing", num(spacing), "",
-                       std::string("must divide ") + s.key + " = " + num(s.length) + " a whole number of times");
+      throw InputError("fluid.sph_spacing", format_short(spacing), "",
+                       std::string("must divide ") + s.key + " = " + format_short(s.length) + " a whole number of times");
   }
   const double support = k_kernel_support * h();
   if (box.ly <= support || box.lz <= support)
-    throw InputError("fluid.sph_spacing", num(spacing), "",
-                     "kernel support 2h = " + num(support) + " m must be shorter than box.ly and box.lz");
+    throw InputError("fluid.sph_spacing", format_short(spacing), "",
+                     "kernel support 2h = " + format_short(support) + " m must be shorter than box.ly and box.lz");
 }
 
 double morris_sound_speed(double v0, double l0, double nu, double body_force, double delta) {

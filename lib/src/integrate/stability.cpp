@@ -7,16 +7,9 @@
 
 #include "mrf/forces/hertz.hpp"
 #include "mrf/integrate/steps.hpp"
+#include "mrf/io/quantity.hpp"
 
 namespace mrf {
-
-namespace {
-std::string fmt(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.3g", v);
-  return b;
-}
-}  // namespace
 
 double verlet_exp_amplification(double omega, double tau, double dt) {
   // The scheme of steps.hpp on r'' = -omega^2 r - r'/tau, per unit mass:
@@ -89,10 +82,10 @@ std::vector<StabilityLimit> dem_limits(const DemParams& p, double gap, Integrato
   out.push_back({"hertz contact", contact_limit_at_overlap(p, scheme, h),
                  (scheme == IntegratorId::implicit ? "backward Euler contacts, no limit; expected overlap/R "
                                                    : "expected overlap/R ") +
-                     fmt(h / p.radius) + " (load " + fmt(p.expected_load) + " N" +
-                     (inertial ? ", impact at " + fmt(p.impact_speed) + " m/s" : "") + ")"});
+                     format_short(h / p.radius, 3) + " (load " + format_short(p.expected_load, 3) + " N" +
+                     (inertial ? ", impact at " + format_short(p.impact_speed, 3) + " m/s" : "") + ")"});
   out.push_back({"drag relaxation", inf,
-                 "tau_p = " + fmt(p.tau_p) + (inertial ? " s (integrated exactly)" : " s (inertia neglected)")});
+                 "tau_p = " + format_short(p.tau_p, 3) + (inertial ? " s (integrated exactly)" : " s (inertia neglected)")});
   if (scheme == IntegratorId::implicit) {
     // The implicit scheme's step is chosen by its error control; these bound
     // it from above. Explicit dipoles: the transverse (aligning) stiffness of
@@ -108,7 +101,7 @@ std::vector<StabilityLimit> dem_limits(const DemParams& p, double gap, Integrato
                      "explicit dipoles, aligning mode of a chain: gamma R / F_contact"});
     if (p.shear_rate > 0)
       out.push_back({"contact margin", 0.5 * k_contact_margin_over_radius * p.radius / wall_speed(p.shear_rate, gap),
-                     "walls move at most half the candidate margin (" + fmt(k_contact_margin_over_radius) +
+                     "walls move at most half the candidate margin (" + format_short(k_contact_margin_over_radius, 3) +
                          " R) per step"});
     return out;
   }

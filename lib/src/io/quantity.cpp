@@ -1,3 +1,4 @@
+#include <cstdio>
 #include "mrf/io/quantity.hpp"
 
 #include <charconv>
@@ -77,6 +78,12 @@ std::string format_number(double x) {
   char buf[32];
   const auto r = std::to_chars(buf, buf + sizeof buf, x);
   return std::string(buf, r.ptr);
+}
+
+std::string format_short(double x, int digits) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, x);
+  return buf;
 }
 
 double parse_quantity(std::string_view text, Dim dim) {

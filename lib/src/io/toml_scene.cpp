@@ -326,12 +326,6 @@ void require_keys(const LoadedScene& s, const Given& given) {
 
 using Why = std::optional<std::string>;
 Why unless(bool ok, const std::string& why) { return ok ? Why{} : Why{why}; }
-// Derived numbers in messages: 6 significant digits are enough to act on.
-std::string num(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", x);
-  return buf;
-}
 double skin_eff(const C& c) { return c.skin > 0 ? c.skin : 0.2 * c.radius; }
 double phi_eff(const C& c) { return c.volume_fraction * c.gap / (c.gap - 4 * c.radius); }
 constexpr double k_max_packing = 0.35;  // random sequential addition jams near 0.38
@@ -344,13 +338,13 @@ struct Rule {
 // Single-key ranges passed already (k_keys); a rule may assume the rules above it passed.
 const Rule k_rules[] = {
     {"box.gap", [](const C& c, const Given&) {
-       return unless(c.gap > 4 * c.radius, "must be > 4*radius = " + num(4 * c.radius) +
+       return unless(c.gap > 4 * c.radius, "must be > 4*radius = " + format_short(4 * c.radius) +
                                                " m (free centres stay 2*radius from each wall)");
      }},
     {"particles.volume_fraction", [](const C& c, const Given&) {
        return unless(phi_eff(c) <= k_max_packing,
                      "cannot be packed: effective fraction volume_fraction*gap/(gap - 4*radius)"
-                     " = " + num(phi_eff(c)) + " (limit " + num(k_max_packing) + ")");
+                     " = " + format_short(phi_eff(c)) + " (limit " + format_short(k_max_packing) + ")");
      }},
     {"particles.magnetization", [](const C& c, const Given& g) {
        return unless(c.magnetization > 0 || !g.count("drive.mason") || c.vary == MasonBy::magnetization,
@@ -359,20 +353,20 @@ const Rule k_rules[] = {
      }},
     {"particles.dipole_cutoff", [](const C& c, const Given&) {
        return unless(c.dipole_cutoff >= 2 * c.radius,
-                     "must be >= 2*radius = " + num(2 * c.radius) + " m");
+                     "must be >= 2*radius = " + format_short(2 * c.radius) + " m");
      }},
     {"particles.dipole_cutoff", [](const C& c, const Given&) {
        const double half = std::min(c.ly, c.lz) / 2;
        return unless(c.dipole_cutoff + skin_eff(c) <= half,
-                     "dipole_cutoff + skin = " + num(c.dipole_cutoff + skin_eff(c)) +
-                         " m exceeds min(box.ly, box.lz)/2 = " + num(half) + " m (minimum image)");
+                     "dipole_cutoff + skin = " + format_short(c.dipole_cutoff + skin_eff(c)) +
+                         " m exceeds min(box.ly, box.lz)/2 = " + format_short(half) + " m (minimum image)");
      }},
     {"walls.spacing", [](const C& c, const Given&) {
        return unless(c.wall_spacing <= 2 * c.radius,
-                     "must be <= 2*radius = " + num(2 * c.radius) + " m");
+                     "must be <= 2*radius = " + format_short(2 * c.radius) + " m");
      }},
     {"drive.warmup_strain", [](const C& c, const Given&) {
-       return unless(c.warmup_strain < c.strain, "must be < drive.strain = " + num(c.strain));
+       return unless(c.warmup_strain < c.strain, "must be < drive.strain = " + format_short(c.strain));
      }},
     {"numerics.implicit_order", [](const C& c, const Given&) {
        return unless(c.implicit_order == 1 || c.implicit_order == 2, "must be 1 or 2");

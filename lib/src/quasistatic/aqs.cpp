@@ -7,6 +7,7 @@
 #include <string>
 
 #include "mrf/error.hpp"
+#include "mrf/io/quantity.hpp"
 #include "mrf/forces/drag.hpp"
 #include "mrf/forces/hertz.hpp"
 #include "mrf/integrate/steps.hpp"
@@ -18,24 +19,18 @@ namespace mrf {
 
 namespace {
 
-std::string num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.6g", v);
-  return b;
-}
-
 void require(bool ok, const char* key, double value, const std::string& why) {
-  if (!ok) throw InputError(std::string("quasistatic.") + key, num(value), "", why);
+  if (!ok) throw InputError(std::string("quasistatic.") + key, format_short(value), "", why);
 }
 
 // The minimum image of the pair lists needs r_c + skin <= min(ly, lz)/2.
 void check_cutoff(double rc, const DemParams& p, const Box& box, const std::string& key, const std::string& where) {
   if (!(rc > 2.0 * p.radius))
-    throw InputError(key, num(rc) + " m", where, "must be > 2*radius = " + num(2.0 * p.radius) + " m");
+    throw InputError(key, format_short(rc) + " m", where, "must be > 2*radius = " + format_short(2.0 * p.radius) + " m");
   const double half = 0.5 * std::min(box.ly, box.lz);
   if (rc + p.skin > half)
-    throw InputError(key, num(rc) + " m", where,
-                     "cut-off + skin = " + num(rc + p.skin) + " m exceeds min(box.ly, box.lz)/2 = " + num(half) +
+    throw InputError(key, format_short(rc) + " m", where,
+                     "cut-off + skin = " + format_short(rc + p.skin) + " m exceeds min(box.ly, box.lz)/2 = " + format_short(half) +
                          " m (minimum image)");
 }
 
@@ -138,9 +133,9 @@ FireResult relax(QuasistaticState& s, const FireOptions& fire, std::size_t incre
   });
   if (!r.converged)
     throw NumericalError("quasistatic: no minimum at increment " + std::to_string(increment) + " (strain " +
-                         num(strain) + "): FIRE stopped (" + r.stop_reason + ") after " +
-                         std::to_string(r.iterations) + " iterations with max |f| = " + num(r.max_force) +
-                         " N above the tolerance " + num(fire.force_tol) +
+                         format_short(strain) + "): FIRE stopped (" + r.stop_reason + ") after " +
+                         std::to_string(r.iterations) + " iterations with max |f| = " + format_short(r.max_force) +
+                         " N above the tolerance " + format_short(fire.force_tol) +
                          " N; raise quasistatic.max_iterations or lower quasistatic.strain_increment");
   return r;
 }
@@ -201,7 +196,7 @@ QuasistaticResult run_quasistatic(const LoadedScene& scene, const QuasistaticOpt
                                   const QuasistaticObserver& observer) {
   const SceneConfig& c = scene.config;
   if (!(c.magnetization > 0))
-    throw InputError("particles.magnetization", num(c.magnetization) + " A/m", scene.locate("particles.magnetization"),
+    throw InputError("particles.magnetization", format_short(c.magnetization) + " A/m", scene.locate("particles.magnetization"),
                      "quasi-static shear needs magnetic particles (its force tolerance is relative to the dipole "
                      "contact force)");
   const DemParams p = dem_params(c);

@@ -5,19 +5,14 @@
 #include <cstdio>
 
 #include "mrf/error.hpp"
+#include "mrf/io/quantity.hpp"
 
 namespace mrf {
 
 namespace {
 
-std::string num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.6g", v);
-  return b;
-}
-
 void require(bool ok, const std::string& key, double value, const char* why) {
-  if (!ok) throw InputError(key, num(value), "", why);
+  if (!ok) throw InputError(key, format_short(value), "", why);
 }
 
 void check_finite(const std::vector<Vec3>& f, long iteration) {

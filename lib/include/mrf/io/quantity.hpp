@@ -28,6 +28,7 @@ std::string normalize_unit(std::string_view unit);
 
 std::string_view trim(std::string_view s);  // without leading/trailing blanks
 std::string format_number(double x);        // shortest text that reads back exactly
+std::string format_short(double x, int digits = 6);  // %.<digits>g: derived numbers in messages
 
 class ValueError : public std::runtime_error {
  public:
