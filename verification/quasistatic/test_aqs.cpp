@@ -13,6 +13,7 @@
 #include "mrf/error.hpp"
 #include "mrf/forces/hertz.hpp"
 #include "mrf/quasistatic/aqs.hpp"
+#include "support/iron_pair.hpp"
 #include "support/small_scene.hpp"
 
 namespace mrf {
@@ -20,17 +21,7 @@ namespace {
 
 constexpr double R = 2.5e-6, M = 1e6;
 
-SceneConfig pair_config() {
-  SceneConfig c;
-  c.radius = R;
-  c.density = 7800;
-  c.magnetization = M;
-  c.youngs_modulus = 200e9;
-  c.poisson_ratio = 0.3;
-  c.viscosity = 0.1;
-  c.dipole_cutoff = 15e-6;
-  return c;
-}
+SceneConfig pair_config() { return test::iron_pair_config(R, M, 15e-6); }
 
 // Two free spheres, no walls, started apart and off the field axis: they
 // turn into the field, meet head-to-tail and compress until Hertz carries

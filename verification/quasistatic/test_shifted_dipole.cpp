@@ -12,6 +12,7 @@
 #include "mrf/quasistatic/aqs.hpp"
 #include "mrf/quasistatic/shifted_dipole.hpp"
 #include "support/fit_order.hpp"
+#include "support/iron_pair.hpp"
 
 namespace mrf {
 namespace {
@@ -105,15 +106,7 @@ TEST(ShiftedDipole, UnshiftedLawUpToShiftTerms) {
 // The scene's pair loop (scene/dem_forces.hpp) running this evaluator gives
 // the pure function's force, +-F, and energy.
 TEST(ShiftedDipole, PairLoopRunsTheLaw) {
-  SceneConfig c;
-  c.radius = R;
-  c.density = 7800;
-  c.magnetization = M;
-  c.youngs_modulus = 200e9;
-  c.poisson_ratio = 0.3;
-  c.viscosity = 0.1;
-  c.dipole_cutoff = rc;
-  const DemParams p = dem_params(c);
+  const DemParams p = dem_params(test::iron_pair_config(R, M, rc));
   ShearCell cell;
   cell.box = Box{100e-6, 40e-6, 40e-6};
   const Vec3 r_ik(4e-6, 1e-6, -7e-6);
