@@ -62,6 +62,7 @@ int quasistatic_command(const std::string& scene_path, const std::vector<std::st
   j["stress_wall_over_phi_mu0_m2_err"] = r.steady_wall.sem / r.stress_scale;
   j["equilibrium_bound"] = r.equilibrium_bound;
   j["force_evaluations"] = r.force_evaluations;
+  j["list_builds"] = r.list_builds;
   j["wall_seconds"] = r.wall_seconds;
   j["seed"] = scene.config.seed;
   j["version"] = mrf::version();
