@@ -129,10 +129,8 @@ def main(argv):
     lines += ["", f"## Steadiness of every run (drift |z| < {DRIFT_Z:g} and MSER-5 discard < {MSER_MAX:g})", "",
               "| model | Mn | seed | strain (warm-up) | drift z | MSER discard | steady | s per strain unit |",
               "|---|---:|---:|---:|---:|---:|---|---:|"]
-    cost = defaultdict(list)
     for r in sorted(rows, key=lambda r: (ORDER.index(r["model"]), float(r["mason"]), int(r["seed"]))):
-        per = num(r, "wall_seconds") / (num(r, "strain") - 0)
-        cost[(r["model"], float(r["mason"]))].append(per)
+        per = num(r, "wall_seconds") / num(r, "strain")
         lines.append(f"| {r['model']} | {float(r['mason']):g} | {r['seed']} | {num(r, 'strain'):g} "
                      f"({num(r, 'warmup_strain'):g}) | {num(r, 'stress_total_drift_z'):+.2f} | "
                      f"{num(r, 'steady_mser_discard_fraction'):.3f} | {'yes' if steady(r) else '**no**'} | "

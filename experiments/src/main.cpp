@@ -15,7 +15,6 @@
 #include "criterion_command.hpp"
 #include "quasistatic_command.hpp"
 #include "mrf/error.hpp"
-#include "mrf/io/atomic_file.hpp"
 #include "mrf/io/lammps_data.hpp"
 #include "mrf/scene/build_model.hpp"
 #include "mrf/scene/run.hpp"
@@ -94,10 +93,7 @@ int sweep_command(const SweepArgs& a) {
     mrf::report_archive(mrf::restore_from_archive(spec, mrf::sweep_points(spec), out, a.archive), a.archive, a.quiet);
   if (a.collect) {  // sweep.csv from the finished points, nothing run (while other ranks still work)
     const auto points = mrf::sweep_points(spec);
-    std::size_t done = 0;
-    for (const auto& p : points) done += mrf::point_finished((std::filesystem::path(out) / p.dir).string()) ? 1 : 0;
-    std::filesystem::create_directories(out);
-    mrf::write_file_atomic((std::filesystem::path(out) / "sweep.csv").string(), mrf::sweep_csv(points, out));
+    const std::size_t done = mrf::write_sweep_csv(points, out);
     std::printf("%zu of %zu points finished -> %s/sweep.csv\n", done, points.size(), out.c_str());
     return 0;
   }

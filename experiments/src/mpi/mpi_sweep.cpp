@@ -22,7 +22,6 @@
 #include <string>
 #include <vector>
 
-#include "mrf/io/atomic_file.hpp"
 #include "mrf/study/sweep.hpp"
 
 extern char** environ;
@@ -116,8 +115,7 @@ int mpi_sweep(const mrf::SweepSpec& spec, const std::string& out, const mrf::Swe
       MPI_Send(&job, 1, MPI_LONG, st.MPI_SOURCE, k_work, MPI_COMM_WORLD);
       if (job < 0) --active;
     }
-    std::filesystem::create_directories(out);
-    mrf::write_file_atomic((std::filesystem::path(out) / "sweep.csv").string(), mrf::sweep_csv(points, out));
+    mrf::write_sweep_csv(points, out);
     std::printf("sweep (MPI, %d ranks): %ld run, %zu skipped (finished before), %ld failed, %zu died -> %s/sweep.csv\n",
                 size, ran, points.size() - order.size(), failed, died.size(), out.c_str());
     for (const std::string& d : died)

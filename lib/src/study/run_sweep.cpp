@@ -230,10 +230,7 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
     }
   }
   outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  if (opt.write_csv) {
-    std::filesystem::create_directories(out_dir);
-    write_file_atomic((std::filesystem::path(out_dir) / "sweep.csv").string(), sweep_csv(points, out_dir));
-  }
+  if (opt.write_csv) write_sweep_csv(points, out_dir);
   return outcome;
 }
 

@@ -299,4 +299,12 @@ std::string sweep_csv(const std::vector<SweepPoint>& points, const std::string& 
   return csv.str();
 }
 
+std::size_t write_sweep_csv(const std::vector<SweepPoint>& points, const std::string& out_dir) {
+  std::filesystem::create_directories(out_dir);
+  write_file_atomic((std::filesystem::path(out_dir) / "sweep.csv").string(), sweep_csv(points, out_dir));
+  std::size_t done = 0;
+  for (const auto& p : points) done += point_finished((std::filesystem::path(out_dir) / p.dir).string()) ? 1 : 0;
+  return done;
+}
+
 }  // namespace mrf

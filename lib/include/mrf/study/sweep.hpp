@@ -95,6 +95,9 @@ bool point_finished(const std::string& point_dir);
 // sweep.csv text: one row per point of `points` that has a summary.json or a
 // failure.json under `out_dir`, with the DESIGN.md summary fields.
 std::string sweep_csv(const std::vector<SweepPoint>& points, const std::string& out_dir);
+// out_dir/sweep.csv rewritten atomically from that text (the folder created
+// if need be); returns the number of finished points (summary.json or failure.json).
+std::size_t write_sweep_csv(const std::vector<SweepPoint>& points, const std::string& out_dir);
 
 struct SweepOptions {
   bool quiet = false;       // no progress on stderr
