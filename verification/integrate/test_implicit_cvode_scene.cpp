@@ -60,8 +60,8 @@ struct Ode {
       cell.walls.x[k] = walls0[k] + Vec3(0, 0, p.shear_rate * walls0[k].x() * t);
       cell.box.wrap(cell.walls.x[k]);
     }
-    // The wall travel since the last build, from the time itself (CVODE may step back).
-    lists.wall_travel = std::abs(p.shear_rate) * 0.5 * cell.box.gap * std::abs(t - t_build);
+    // The imposed strain since the last build, from the time itself (CVODE may step back).
+    lists.strain_ff = lists.strain_fw = p.shear_rate * (t - t_build);
     if (needs_rebuild(lists, f, cell.box)) {
       rebuild_all_pair_lists(lists, f, cell.walls, cell.box);
       t_build = t;

@@ -23,6 +23,7 @@ struct DemParams {
   double contact_force;  // head-to-tail dipole force at contact (pi/6) mu0 R^2 M^2 (N)
   double expected_load;  // largest contact load the time step is designed for (N)
   double impact_speed;   // largest expected approach speed of a contact pair (m/s)
+  bool adaptive_skin = false;  // skin chosen for cost from the start value `skin` (neighbors/verlet_list.hpp)
 };
 
 }  // namespace mrf

@@ -118,6 +118,50 @@ SphPairs find_pairs(const FluidCell& cell, double rc) {
   return out;
 }
 
+namespace {
+// Candidates within 2h + skin of the cell's positions, sorted by (a, b,
+// image), so that the pairs, and the round-off of every sum over them, do
+// not depend on when the candidates were built.
+SphPairs sorted_candidates(const FluidCell& cell, double skin) {
+  SphPairs c = find_pairs(cell, k_kernel_support * cell.h + skin);
+  auto order = [](const SphPair& p, const SphPair& q) {
+    if (p.a != q.a) return p.a < q.a;
+    if (p.b != q.b) return p.b < q.b;
+    if (p.r_ab.y() != q.r_ab.y()) return p.r_ab.y() < q.r_ab.y();
+    return p.r_ab.z() < q.r_ab.z();
+  };
+  std::sort(c.fluid_fluid.begin(), c.fluid_fluid.end(), order);
+  std::sort(c.fluid_wall.begin(), c.fluid_wall.end(), order);
+  return c;
+}
+
+bool cache_stale(const FluidCell& cell, const SphPairCache& cache) {
+  if (cache.x_fluid.size() != cell.fluid.size() || cache.x_wall.size() != cell.wall.size()) return true;
+  const Box& box = cell.box;
+  const double reach = k_kernel_support * cell.h + cache.skin, flow = std::abs(cache.strain) * reach;
+  const double df = max_nonaffine_displacement(cell.fluid.x, cache.x_fluid, box, cache.strain);
+  const double dw = max_nonaffine_displacement(cell.wall.x, cache.x_wall, box, cache.strain);
+  // The separations are continued by minimum-image displacements: keep them
+  // far below half the box.
+  const double quarter = 0.25 * std::min(box.ly, box.lz);
+  return 2.0 * df + flow > cache.skin || df + dw + flow > cache.skin ||
+         max_displacement(cell.fluid.x, cache.x_fluid, box) > quarter ||
+         max_displacement(cell.wall.x, cache.x_wall, box) > quarter;
+}
+}  // namespace
+
+void restore_candidates(const FluidCell& cell, SphPairCache& cache) {
+  if (cache.x_fluid.size() != cell.fluid.size() || cache.x_wall.size() != cell.wall.size()) {
+    cache.candidates = {};
+    cache.x_fluid.clear();  // rebuilt at the next update
+    return;
+  }
+  FluidCell at_ref = cell;
+  at_ref.fluid.x = cache.x_fluid;
+  at_ref.wall.x = cache.x_wall;
+  cache.candidates = sorted_candidates(at_ref, cache.skin);
+}
+
 void update_pairs(FluidCell& cell, SphPairCache& cache) {
   const double rc = k_kernel_support * cell.h;
   if (!(cache.skin > 0)) {
@@ -125,24 +169,11 @@ void update_pairs(FluidCell& cell, SphPairCache& cache) {
     return;
   }
   const Box& box = cell.box;
-  const bool stale = cache.x_fluid.size() != cell.fluid.size() || cache.x_wall.size() != cell.wall.size();
-  const double df = stale ? 0.0 : max_displacement(cell.fluid.x, cache.x_fluid, box);
-  const double dw = stale ? 0.0 : max_displacement(cell.wall.x, cache.x_wall, box);
-  if (stale || 2.0 * df > cache.skin || df + dw > cache.skin) {
-    cache.candidates = find_pairs(cell, rc + cache.skin);
-    // Sorted by (a, b, image), so that the pairs, and the round-off of every
-    // sum over them, do not depend on when the candidates were built (a
-    // resumed run rebuilds them at once).
-    auto order = [](const SphPair& p, const SphPair& q) {
-      if (p.a != q.a) return p.a < q.a;
-      if (p.b != q.b) return p.b < q.b;
-      if (p.r_ab.y() != q.r_ab.y()) return p.r_ab.y() < q.r_ab.y();
-      return p.r_ab.z() < q.r_ab.z();
-    };
-    std::sort(cache.candidates.fluid_fluid.begin(), cache.candidates.fluid_fluid.end(), order);
-    std::sort(cache.candidates.fluid_wall.begin(), cache.candidates.fluid_wall.end(), order);
+  if (cache_stale(cell, cache)) {
+    cache.candidates = sorted_candidates(cell, cache.skin);
     cache.x_fluid = cell.fluid.x;
     cache.x_wall = cell.wall.x;
+    cache.strain = 0;
     ++cache.builds;
   }
   // The separation is computed as find_pairs does (minimum image, then the

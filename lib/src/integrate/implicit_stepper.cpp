@@ -18,6 +18,12 @@ namespace {
 // BDF2's local error is -(2/9) h^3 x''', the extrapolation's +h^3 x''', so
 // the error is (2/9)/(1 + 2/9) = 2/11 of their difference.
 constexpr double k_bdf2_error_constant = 2.0 / 11.0;
+// Largest growth of the step from one accepted step to the next.
+constexpr double k_max_growth = 2.0;
+// After a Newton failure at dt, later steps stay below this fraction of
+// it, a bound that relaxes by k_newton_cap_relax per accepted step: a failure
+// costs max_newton iterations, so the controller does not walk back into it.
+constexpr double k_newton_cap_after_failure = 0.8, k_newton_cap_relax = 1.02;
 // A step shorter than this fraction of the largest allowed one is a failure.
 constexpr double k_dt_floor = 1e-7;
 
@@ -33,9 +39,12 @@ const std::vector<Vec3>& ImplicitStepper::begin_step(const DemPairLists& lists, 
                                                      const WallParticles& walls, const Box& box) {
   const double r = p_.radius, margin = k_contact_margin_over_radius * r;
   const double near_skin = near_reach_ - (2.0 * r + margin);
-  if (near_x_.size() != f.size() || 2.0 * max_displacement(f.x, near_x_, box) > near_skin) {
+  if (near_x_.size() != f.size() ||
+      2.0 * max_nonaffine_displacement(f.x, near_x_, box, near_strain_) + std::abs(near_strain_) * near_reach_ >
+          near_skin) {
     near_pairs(lists.ff, f.x, box, near_reach_, near_ff_);
     near_x_ = f.x;
+    near_strain_ = 0;
   }
   contact_candidates(near_ff_, lists.fw, f.x, walls, box, r, margin, candidates_);
   contact_forces(candidates_, f.x, walls, box, r, p_.hertz_k, fc_);
@@ -107,7 +116,9 @@ ImplicitStepper::Attempt ImplicitStepper::attempt(double dt, const ImplicitDrift
     } else {
       a.error = std::max(a.error, 0.5 * (f.x[i] - x0_[i] - dt * f.v[i]).norm());
     }
-    const double disp = (f.x[i] - x0_[i]).norm();
+    Vec3 step = f.x[i] - x0_[i];
+    step.z() -= p_.shear_rate * dt * x0_[i].x();  // less the affine part (the candidates' bound)
+    const double disp = step.norm();
     if (disp > a.displacement) a.displacement = disp, a.moved = static_cast<std::uint32_t>(i);
   }
   return a;
@@ -125,22 +136,34 @@ double ImplicitStepper::advance(const ImplicitDrift& d, FreeParticles& f, WallPa
   const double dt_floor = k_dt_floor * std::min(dt, dt_max);
   // The local error scales as dt^2 (order 1) or dt^3 (order 2).
   const double exponent = opt_.order == 2 && history_ >= 2 ? -1.0 / 3.0 : -0.5;
+  bool retried = false;
   for (;;) {
     const Attempt a = attempt(dt, d, nopt, f, walls, box);
-    const bool too_far = a.displacement > 0.5 * margin || p_.wall_speed * dt > 0.5 * margin;
+    // The contact candidates of x_n (pairs within 2R + margin) hold all
+    // contacts of the step while no pair closes by more than the margin:
+    // two non-affine displacements plus the imposed flow's change of the
+    // separation (strain times at most 2R + margin; the walls move affinely).
+    const bool too_far = 2.0 * a.displacement + std::abs(p_.shear_rate * dt) * (2.0 * r + margin) > margin;
     const double ratio = a.error / (opt_.tol_over_radius * r);
     if (opt_.fixed_step && (!a.newton.converged || too_far)) {
       std::ostringstream m;
       m << "implicit fixed step " << dt << " s failed at step " << step << " (t = " << time << " s): "
         << (a.newton.converged ? "particle " + std::to_string(a.moved) + " moved " + std::to_string(a.displacement / r) +
-                                     " R, more than half the contact margin"
+                                     " R off the imposed flow: a pair may close by more than the contact margin"
                                : "Newton did not converge; largest correction at particle " +
                                      std::to_string(a.newton.worst));
       throw NumericalError(m.str());
     }
     if (a.newton.converged && !too_far && (ratio <= 1.0 || opt_.fixed_step)) {
       for (std::size_t i = 0; i < f.size(); ++i) f.v[i] = (f.x[i] - x0_[i]) / dt;
-      dt_try_ = std::min(dt_max_, dt * std::min(2.0, 0.9 * std::pow(std::max(ratio, 1e-6), exponent)));
+      // No growth right after a rejection (Hairer & Wanner's rule: the step
+      // that just failed is a better guess than the error model), nor after
+      // a Newton solve that took more than half its iterations (a longer
+      // step would likely fail to converge, and a failure costs them all).
+      const double growth = retried || 2 * a.newton.iterations > opt_.max_newton ? 1.0 : k_max_growth;
+      dt_try_ = std::min(dt_max_, dt * std::min(growth, 0.9 * std::pow(std::max(ratio, 1e-6), exponent)));
+      newton_cap_ *= k_newton_cap_relax;
+      dt_try_ = std::min(dt_try_, newton_cap_);
       if (opt_.order == 2) {
         x_prev2_.swap(x_prev_);
         x_prev_ = x0_;
@@ -151,6 +174,8 @@ double ImplicitStepper::advance(const ImplicitDrift& d, FreeParticles& f, WallPa
       break;
     }
     ++(a.newton.converged ? counters_.rejected : counters_.newton_failures);
+    if (!a.newton.converged) newton_cap_ = k_newton_cap_after_failure * dt;
+    retried = true;
     dt *= !a.newton.converged ? 0.25 : too_far ? 0.5 : std::max(0.2, 0.9 * std::pow(ratio, exponent));
     if (!(dt >= dt_floor)) {
       std::ostringstream m;
@@ -161,6 +186,7 @@ double ImplicitStepper::advance(const ImplicitDrift& d, FreeParticles& f, WallPa
     }
   }
   dt_ = dt;
+  near_strain_ += p_.shear_rate * dt;
   counters_.dt_min = std::min(counters_.dt_min, dt);
   counters_.dt_max = std::max(counters_.dt_max, dt);
   return dt;

@@ -92,17 +92,18 @@ std::vector<StabilityLimit> dem_limits(const DemParams& p, double gap, Integrato
     // a head-to-tail pair at contact is F/(2R), and the alternating mode of a
     // chain relaxes at 4 (F/2R)/gamma, so explicit Euler on it is stable for
     // dt < gamma R / F. (BDF2's extrapolated explicit part has a smaller
-    // stability interval, about half; on the small and paper scenes this
-    // limit is still 6-12x above the contact-margin bound, which binds.) Contact candidates: a step must not move the walls by
-    // more than half the candidate margin (dem_model.cpp), or a contact could
-    // be missed.
+    // stability interval, about half.) Contact candidates: the imposed flow
+    // must not close a pair by more than the candidate margin in one step,
+    // |gdot| dt (2R + margin) <= margin (integrate/implicit_stepper.cpp), or
+    // a contact could be missed.
     if (p.contact_force > 0)
       out.push_back({"dipole stability", p.gamma * p.radius / p.contact_force,
                      "explicit dipoles, aligning mode of a chain: gamma R / F_contact"});
     if (p.shear_rate > 0)
-      out.push_back({"contact margin", 0.5 * k_contact_margin_over_radius * p.radius / wall_speed(p.shear_rate, gap),
-                     "walls move at most half the candidate margin (" + format_short(k_contact_margin_over_radius, 3) +
-                         " R) per step"});
+      out.push_back({"contact margin",
+                     k_contact_margin_over_radius / ((2.0 + k_contact_margin_over_radius) * std::abs(p.shear_rate)),
+                     "the imposed flow closes a pair by at most the candidate margin (" +
+                         format_short(k_contact_margin_over_radius, 3) + " R) per step"});
     return out;
   }
   // Accuracy bounds: a contact pair under the head-to-tail force, or a wall

@@ -105,7 +105,7 @@ void evaluate_forces(QuasistaticState& s) {
 void apply_strain_increment(QuasistaticState& s, double d_gamma, bool affine) {
   ShearCell& c = s.cell;
   move_walls(c.walls, d_gamma, 1.0);  // gdot dt = d_gamma
-  s.lists.wall_travel += wall_speed(d_gamma, c.box.gap);
+  advance_pair_lists(s.lists, d_gamma);
   if (affine)
     for (Vec3& x : c.free.x) x += couette_velocity(x, d_gamma);  // the same profile, over unit time
 }

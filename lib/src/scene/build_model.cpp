@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <sstream>
 
 #include "mrf/error.hpp"
@@ -28,6 +29,11 @@ constexpr double k_design_porosity = 0.5;
 // particle moves ~1e-7 of h per sub-step, so the list lasts tens of sub-steps.
 constexpr double k_sph_skin_over_h = 0.2;
 
+// An error-controlled step is at most this fraction of the averaging
+// window (drive.strain - drive.warmup_strain), so that the window holds at
+// least this many rows (one per step at most) for block averaging.
+constexpr double k_window_steps = 64;
+
 std::string g3(double v) {
   char b[32];
   std::snprintf(b, sizeof b, "%.3g", v);
@@ -49,6 +55,13 @@ void print_table(const char* label, const std::vector<StabilityLimit>& limits) {
 
 }  // namespace
 
+StabilityLimit window_limit(const SceneConfig& c) {
+  const double window = c.strain - c.warmup_strain;
+  const double dt = c.shear_rate != 0 && window > 0 ? window / (k_window_steps * std::abs(c.shear_rate))
+                                                    : std::numeric_limits<double>::infinity();
+  return {"averaging window", dt, "at least 64 steps in drive.strain - drive.warmup_strain"};
+}
+
 TimeStepChoice choose_time_step(const LoadedScene& scene, const DemParams& p) {
   const SceneConfig& c = scene.config;
   auto ve = dem_limits(p, c.gap, IntegratorId::verlet_exp);
@@ -59,7 +72,10 @@ TimeStepChoice choose_time_step(const LoadedScene& scene, const DemParams& p) {
   switch (t.scheme) {
     case IntegratorId::verlet_exp: t.limits = ve, t.other = od; break;
     case IntegratorId::overdamped: t.limits = od, t.other = ve; break;
-    default: t.limits = im, t.other = smallest(ve) >= smallest(od) ? ve : od; break;
+    default:
+      t.limits = im, t.other = smallest(ve) >= smallest(od) ? ve : od;
+      t.limits.push_back(window_limit(c));
+      break;
   }
   const StabilityLimit& b = binding(t.limits);
   if (c.dt) {
@@ -96,6 +112,7 @@ CoupledTimeStep choose_coupled_time_step(const LoadedScene& scene, const DemPara
   t.fluid_limits = stability_limits(fluid, SphImplicit::viscosity);
   const double viscous = coupled_viscous_limit(fluid, eps_min);
   t.dem_limits = dem_limits(p, c.gap, inertialess ? IntegratorId::implicit : IntegratorId::verlet_exp);
+  if (inertialess) t.dem_limits.push_back(window_limit(c));
   if (inertialess && c.dt_safety * smallest(t.fluid_limits) < (c.dt ? *c.dt : smallest(t.dem_limits))) {
     s.sph = SphImplicit::pressure_viscosity;
     t.fluid_limits = stability_limits(fluid, s.sph);

@@ -14,8 +14,8 @@
 // recomputes them with the calls that end step(), refresh() and
 // update_coupling_pairs(): the SPH pairs, summation densities, porosities,
 // fluid and wall pressures and wall densities, the DEM-SPH pairs (with the
-// wall mirror images), the SPH pair cache of the inertialess scheme (its
-// pairs are sorted, so a rebuild gives the same list) and the porosity
+// wall mirror images), the SPH pair cache's candidates (found again from
+// its saved reference positions: the same sorted list) and the porosity
 // range of sums_. Not saved because
 // step() recomputes them before use: the Shepard fields, buoyancy, friction
 // coefficients and parcel state (prepare_coupling sets parcel u to the fluid
@@ -43,14 +43,14 @@ void CoupledModel::load(ArchiveReader& in) {
     throw NumericalError("checkpoint does not match the scene: SPH particle counts differ");
   fluid_.time = time_;
   fluid_.steps = steps_;
-  // as at the end of step(); the SPH pair cache is rebuilt (its pairs are
-  // sorted, so they do not depend on when)
-  const long builds = sph_pairs_.builds;
-  sph_pairs_ = SphPairCache{stepping_.sph_skin, {}, {}, {}, builds};
-  if (implicit_)
+  // as at the end of step(); the SPH pair cache finds its candidates again
+  // at its reference positions
+  if (implicit_) {
+    restore_candidates(fluid_, sph_pairs_);
     refresh(fluid_, sph_pairs_);
-  else
+  } else {
     refresh(fluid_);
+  }
   update_coupling_pairs();
 }
 

@@ -45,7 +45,7 @@ void CoupledModel::inertialess_step() {
   }
   response_.add(f_nc, 1.0, drift_.w1);
   const double dt = implicit_->advance(drift_, f, cell_.walls, cell_.box, time_, steps_);
-  lists_.wall_travel += wall_speed(p_.shear_rate, cell_.box.gap) * dt;
+  advance_pair_lists(lists_, p_.shear_rate * dt);
   implicit_->contact_forces_end(f, cell_.walls, cell_.box, fc_end_);
   // What the fluid gave the particles (drag + buoyancy) is minus what they
   // pass on: -(F_c + F_nc + body) dt per particle.
@@ -69,6 +69,7 @@ void CoupledModel::inertialess_step() {
     if (s > 0) a = fluid_acceleration(sph == SphImplicit::none, false);
     advance_fluid(h, kick, a, sph);
     time_ = t0 + (s + 1) * h;
+    sph_pairs_.strain += p_.shear_rate * h;
     refresh(fluid_, sph_pairs_);
   }
   time_ = t0 + dt;

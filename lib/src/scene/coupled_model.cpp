@@ -103,7 +103,7 @@ CoupledModel::CoupledModel(ShearCell cell, const DemParams& params, FluidCell fl
   lists_ = dem_pair_lists(p_, cell_.box, inertialess, cell_.walls.size() > 0, near_reach);
   sph_pairs_.skin = stepping_.sph_skin;
   if (inertialess) {
-    implicit_.emplace(stepping_.implicit, implicit_contact_params(p_, cell_.box), stepping_.dt_max, near_reach);
+    implicit_.emplace(stepping_.implicit, implicit_contact_params(p_), stepping_.dt_max, near_reach);
     overlap_limit_ = p_.radius;
   } else {
     overlap_limit_ = critical_overlap(p_, IntegratorId::verlet_exp, dt_dem());
@@ -281,7 +281,7 @@ void CoupledModel::dem_substep() {
   const Vec3 dem_old = sum_of(f.f);
   parcel_advance(f.x, f.v, f_old_, coupling_, parcel_, p_.mass, h);
   move_walls(cell_.walls, p_.shear_rate, h);
-  lists_.wall_travel += wall_speed(p_.shear_rate, cell_.box.gap) * h;
+  advance_pair_lists(lists_, p_.shear_rate * h);
   update_dem_forces();
   for (std::size_t i = 0; i < f.size(); ++i) f_new_[i] = f.f[i] + buoyancy_[i] + body_force_;
   parcel_correct(f.v, f_old_, f_new_, coupling_, parcel_, p_.mass, h);

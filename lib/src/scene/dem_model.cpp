@@ -23,25 +23,29 @@ namespace {
 constexpr double k_implicit_skin_over_radius = 0.8;
 // Skin of the near list of contact candidates (a refresh scans the dipole list).
 constexpr double k_near_skin_over_radius = 1.0;
+// Smallest skin an adaptive choice may take.
+constexpr double k_min_skin_over_radius = 0.05;
 }  // namespace
 
 DemPairLists dem_pair_lists(const DemParams& p, const Box& box, bool implicit, bool walls, double& near_reach) {
   const double two_r = 2.0 * p.radius;
   const double contact_reach = implicit ? two_r + k_contact_margin_over_radius * p.radius : two_r;
   const double ff_range = p.dipole_pref > 0 ? std::max(p.dipole_cutoff, contact_reach) : contact_reach;
-  // An implicit step moves particles up to half the contact margin, so a
-  // 0.2 R skin would be rebuilt at every step: it is raised to
-  // k_implicit_skin_over_radius where the minimum image allows.
+  // An adaptive skin starts from 0.2 R, or for the implicit scheme, whose
+  // steps are long, from k_implicit_skin_over_radius where the minimum
+  // image allows; a skin the scene gives is kept.
+  const double largest = 0.5 * std::min(box.ly, box.lz) - ff_range;
   double skin = p.skin;
-  if (implicit)
-    skin = std::max(skin, std::min(k_implicit_skin_over_radius * p.radius, 0.5 * std::min(box.ly, box.lz) - ff_range));
+  if (implicit && p.adaptive_skin) skin = std::max(skin, std::min(k_implicit_skin_over_radius * p.radius, largest));
   near_reach = std::min(ff_range, contact_reach + k_near_skin_over_radius * p.radius);
-  return make_pair_lists(ff_range, walls ? contact_reach : 0.0, skin);
+  SkinPolicy policy;
+  policy.adaptive = p.adaptive_skin;
+  policy.min = std::min(k_min_skin_over_radius * p.radius, skin);
+  policy.max = std::max(largest, skin);
+  return make_pair_lists(ff_range, walls ? contact_reach : 0.0, skin, policy);
 }
 
-ImplicitContactParams implicit_contact_params(const DemParams& p, const Box& box) {
-  return {p.radius, p.hertz_k, p.shear_rate, wall_speed(p.shear_rate, box.gap)};
-}
+ImplicitContactParams implicit_contact_params(const DemParams& p) { return {p.radius, p.hertz_k, p.shear_rate}; }
 
 DemModel::DemModel(ShearCell cell, const DemParams& params, IntegratorId scheme, double dt)
     : cell_(std::move(cell)), p_(params), scheme_(scheme), dt_(dt) {
@@ -53,7 +57,7 @@ DemModel::DemModel(ShearCell cell, const DemParams& params, IntegratorId scheme,
   double near_reach = 0;
   lists_ = dem_pair_lists(p_, cell_.box, implicit, cell_.walls.size() > 0, near_reach);
   if (implicit) {
-    implicit_.emplace(ImplicitOptions{}, implicit_contact_params(p_, cell_.box), dt, near_reach);
+    implicit_.emplace(ImplicitOptions{}, implicit_contact_params(p_), dt, near_reach);
     drift_.inv_gamma.assign(cell_.free.size(), 1.0 / p_.gamma);
   }
   overlap_limit_ = scheme_ == IntegratorId::implicit ? p_.radius : critical_overlap(p_, scheme_, dt_);
@@ -78,7 +82,7 @@ void DemModel::step() {
     overdamped_drift(f.x, f.v, f.f, p_.gamma, p_.shear_rate, dt_);
   }
   move_walls(cell_.walls, p_.shear_rate, dt_);
-  lists_.wall_travel += wall_speed(p_.shear_rate, cell_.box.gap) * dt_;
+  advance_pair_lists(lists_, p_.shear_rate * dt_);
   time_ += dt_;
   ++steps_;
   update_forces();
@@ -95,7 +99,7 @@ void DemModel::implicit_step() {
   for (std::size_t i = 0; i < f.size(); ++i)
     drift_.w0[i] = drift_velocity(f.x[i], f.f[i] - fc[i], 1.0 / p_.gamma, p_.shear_rate);
   const double dt = implicit_->advance(drift_, f, cell_.walls, cell_.box, time_, steps_);
-  lists_.wall_travel += wall_speed(p_.shear_rate, cell_.box.gap) * dt;
+  advance_pair_lists(lists_, p_.shear_rate * dt);
   time_ += dt;
   ++steps_;
   update_forces();

@@ -33,6 +33,7 @@ DemParams dem_params(const SceneConfig& c) {
   p.dipole_pref = dipole_prefactor(p.moment);
   p.dipole_cutoff = c.dipole_cutoff;
   p.skin = c.skin > 0 ? c.skin : 0.2 * c.radius;
+  p.adaptive_skin = !(c.skin > 0);
   p.shear_rate = c.shear_rate;
   p.viscosity = c.viscosity;
   p.contact_force = dipole_contact_force(c.radius, c.magnetization);

@@ -1,5 +1,6 @@
 #include "mrf/scene/run.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -71,6 +72,11 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
   s.extra["seconds_per_strain"] = s.wall_seconds / c.strain;
   s.max_overlap_over_radius = st.max_overlap / c.radius;
   s.neighbor_builds = model.lists().builds;
+  // The Verlet skin at the end (chosen for cost unless numerics.skin is set)
+  // and the steps per free-free build (neighbors/verlet_list.hpp).
+  s.extra["neighbor_skin_over_radius"] = model.lists().skin / c.radius;
+  s.extra["steps_per_pair_list_build"] =
+      static_cast<double>(n) / static_cast<double>(std::max(1L, model.lists().ff_builds));
   s.particle_steps_per_second = static_cast<double>(s.n_particles * s.steps) / s.wall_seconds;
   s.pair_evaluations_per_second = static_cast<double>(st.pair_evals) / s.wall_seconds;
   files.finish(s);

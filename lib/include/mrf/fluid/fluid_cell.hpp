@@ -103,20 +103,33 @@ SphPairs find_pairs(const FluidCell& cell);
 SphPairs find_pairs(const FluidCell& cell, double reach);
 
 // Verlet candidates of the SPH pairs: the pairs within 2h + skin at the
-// reference positions, each with its separation there. While no particle
-// has moved more than skin/2 (fluid-fluid) or the fluid and wall particles
-// together more than the skin, every pair within 2h is a candidate, and its
-// separation now is r_ab(ref) + d_a - d_b with the displacements d since the
-// reference (minimum image: positions are wrapped in y and z each step).
-// The pairs come sorted by (a, b, image), whenever the cache was built.
+// reference positions, each with its separation there. While the bound of
+// neighbors/verlet_list.hpp holds (non-affine displacements plus the
+// imposed strain since the build times the reach; the SPH wall particles
+// move with their wall plane, so their non-affine part is the strain times
+// their depth), every pair within 2h is a candidate, and its separation now
+// is r_ab(ref) + d_a - d_b with the displacements d since the reference
+// (minimum image: positions are wrapped in y and z each step, and the cache
+// is rebuilt before any displacement reaches a quarter of the box). The
+// pairs come sorted by (a, b, image), whenever the cache was built.
 struct SphPairCache {
   double skin = 0;              // m; 0 = search every time
   SphPairs candidates;
   std::vector<Vec3> x_fluid, x_wall;  // reference positions
+  double strain = 0;            // imposed strain since the build (signed); the caller adds gdot dt
   long builds = 0;
+  // Checkpoints: the reference positions and the strain; the candidates are
+  // found again from the reference positions (restore_candidates).
+  template <class Archive, class Self>
+  static void serialize(Archive& ar, Self& s) {
+    ar.io(s.x_fluid, s.x_wall, s.strain, s.builds);
+  }
 };
 
 // cell.pairs for the current positions, from the cache (rebuilt when due).
 void update_pairs(FluidCell& cell, SphPairCache& cache);
+// The candidates of a loaded cache, from its reference positions: the list
+// the cache held when it was saved.
+void restore_candidates(const FluidCell& cell, SphPairCache& cache);
 
 }  // namespace mrf

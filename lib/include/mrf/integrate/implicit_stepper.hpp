@@ -77,9 +77,9 @@ struct ImplicitDrift {
 };
 
 // Contact geometry and law of the step: identical spheres of `radius` (m),
-// Hertz prefactor (N/m^1.5), the walls' shear rate (1/s) and their speed (m/s).
+// Hertz prefactor (N/m^1.5) and the imposed shear rate (1/s).
 struct ImplicitContactParams {
-  double radius = 0, hertz_k = 0, shear_rate = 0, wall_speed = 0;
+  double radius = 0, hertz_k = 0, shear_rate = 0;
 };
 
 class ImplicitStepper {
@@ -116,7 +116,7 @@ class ImplicitStepper {
   // The history (last steps, next try, counters); the near list is derived.
   template <class Archive, class Self>
   static void serialize(Archive& ar, Self& s) {
-    ar.io(s.dt_, s.dt_try_, s.counters_, s.x_prev_, s.x_prev2_, s.w_prev_, s.dt_prev2_, s.history_);
+    ar.io(s.dt_, s.dt_try_, s.newton_cap_, s.counters_, s.x_prev_, s.x_prev2_, s.w_prev_, s.dt_prev2_, s.history_);
   }
   void save(ArchiveWriter& out) const { serialize(out, *this); }
   void load(ArchiveReader& in) {
@@ -127,8 +127,8 @@ class ImplicitStepper {
  private:
   struct Attempt {
     NewtonResult newton;
-    double error = 0, displacement = 0;  // m
-    std::uint32_t moved = 0;             // particle with the largest displacement
+    double error = 0, displacement = 0;  // m; displacement: the largest non-affine one
+    std::uint32_t moved = 0;             // particle with the largest non-affine displacement
   };
   Attempt attempt(double dt, const ImplicitDrift& d, const NewtonOptions& nopt, FreeParticles& f,
                   WallParticles& walls, const Box& box);
@@ -137,15 +137,17 @@ class ImplicitStepper {
   ImplicitContactParams p_;
   ImplicitCounters counters_;
   double dt_, dt_max_, dt_try_, stop_time_ = std::numeric_limits<double>::infinity();
+  double newton_cap_ = std::numeric_limits<double>::infinity();  // step bound after a Newton failure (s)
   ContactNewton newton_;
   ContactDual dual_;
   std::vector<ContactPair> candidates_;
   // Free-free pairs within near_reach_ = 2R + margin + near skin at the
   // positions near_x_, taken from the (longer) dipole Verlet list; refreshed
-  // when a particle has moved half the near skin.
+  // when a pair may have closed by the near skin (the bound of
+  // neighbors/verlet_list.hpp with the strain near_strain_ since then).
   std::vector<ContactPair> near_ff_;
   std::vector<Vec3> near_x_;
-  double near_reach_;
+  double near_reach_, near_strain_ = 0;
   std::vector<Vec3> x0_, b_, fc_;
   std::vector<double> mob_;
   WallParticles walls0_;

@@ -38,6 +38,10 @@ struct MinImageYZ {
   }
   double wrap_y(double dy) const { return dy - ly * round_nearest(dy * inv_ly); }
   double wrap_z(double dz) const { return dz - lz * round_nearest(dz * inv_lz); }
+  // minimum image of a - b
+  Vec3 delta(const Vec3& a, const Vec3& b) const {
+    return Vec3(a.x() - b.x(), wrap_y(a.y() - b.y()), wrap_z(a.z() - b.z()));
+  }
   // |minimum image of a - b|^2
   double norm2(const Vec3& a, const Vec3& b) const {
     const double dx = a.x() - b.x(), dy = wrap_y(a.y() - b.y()), dz = wrap_z(a.z() - b.z());

@@ -31,6 +31,11 @@ struct TimeStepChoice {
 // user dt above the smallest limit is an InputError on numerics.dt.
 TimeStepChoice choose_time_step(const LoadedScene& scene, const DemParams& p);
 
+// The step bound of the error-controlled schemes from the averaging window:
+// at least 64 steps in drive.strain - drive.warmup_strain, so that block
+// averaging has its rows (a sampling bound, added after the scheme is chosen).
+StabilityLimit window_limit(const SceneConfig& c);
+
 struct CoupledTimeStep {
   CoupledStepping stepping;
   std::vector<StabilityLimit> dem_limits;    // of the DEM step (inertial: sub-step)

@@ -157,7 +157,7 @@ class CoupledModel final : public Model {
     ar.io(m.fluid_.fluid.x, m.fluid_.fluid.v, m.fluid_.fluid.a_ext, m.fluid_.fluid.rest_density, m.fluid_.wall.x,
           m.fluid_.wall.v, m.sums_.wall_reflections, m.external_impulse_, m.time_, m.steps_, m.eps_seen_min_,
           m.eps_seen_max_, m.clamped_steps_);
-    if (m.implicit_) ar.io(*m.implicit_, m.fluid_substeps_, m.sph_pairs_.builds, m.viscous_iterations_);
+    if (m.implicit_) ar.io(*m.implicit_, m.fluid_substeps_, m.sph_pairs_, m.viscous_iterations_);
   }
   void update_coupling_pairs();
   void prepare_coupling(const std::vector<Vec3>& a_fluid);

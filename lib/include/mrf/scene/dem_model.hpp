@@ -87,7 +87,7 @@ class DemModel final : public Model {
 // contact margin) and its skin; near_reach (m) is that of the implicit
 // scheme's near list of contact candidates.
 DemPairLists dem_pair_lists(const DemParams& p, const Box& box, bool implicit, bool walls, double& near_reach);
-ImplicitContactParams implicit_contact_params(const DemParams& p, const Box& box);
+ImplicitContactParams implicit_contact_params(const DemParams& p);
 
 // The DEM part of a checkpoint, shared by DemModel and CoupledModel: free
 // particles (x, v, f), wall positions and the Verlet lists as built; one
