@@ -138,6 +138,33 @@ def main(argv):
     lines += ["", "Cost: wall seconds per strain unit of each run, one thread, on a shared 2-core machine "
               "(the sweep ran at nice 19 beside other work: an upper bound, not a benchmark; "
               "reports/performance/model_ratios.md has the side-by-side ratios).", ""]
+    # ---- wall against volume stress: what the imposed flow of model 1 absorbs --
+    lines += ["## Wall and volume-side stress per model", "",
+              "Seed means over φμ0M²; volume side = the particle pair virial plus the carrier's part (model 1: "
+              "eta gdot; models 2 and 3: the SPH virial and the exchange virial). m = 1 - wall/volume is the "
+              "share of the particle stress that model 1's imposed flow absorbs instead of returning to the "
+              "walls; a two-way model returns it (m near 0). Last column: each model's volume-side stress "
+              "against the wall stress of demsph_dd at the same Mn.", "",
+              "| model | Mn | seeds | wall | volume side | m | volume / wall(demsph_dd) - 1 |",
+              "|---|---:|---:|---:|---:|---:|---:|"]
+    by = defaultdict(list)
+    for r in rows:
+        by[(r["model"], float(r["mason"]))].append(r)
+    for k in models:
+        for m in grid:
+            rs = by.get((k, m))
+            if not rs:
+                continue
+            sc = phi * MU0 * num(rs[0], "magnetization") ** 2
+            wall = sum(num(r, "stress_total") for r in rs) / len(rs) / sc
+            vol = sum(num(r, "stress_virial_total") for r in rs) / len(rs) / sc
+            ref = by.get(("demsph_dd", m))
+            cmp3 = "–"
+            if ref:
+                w3 = sum(num(r, "stress_total") for r in ref) / len(ref) / sc
+                cmp3 = f"{vol / w3 - 1:+.3f}"
+            lines.append(f"| {k} | {m:g} | {len(rs)} | {wall:.4f} | {vol:.4f} | {1 - wall / vol:+.3f} | {cmp3} |")
+    lines.append("")
     lines += ["## Flow-curve fits (mrf criterion)", "",
               "| model | Bingham Mn* | power-law Mn* | Delta | chi2/dof | note |", "|---|---:|---:|---:|---:|---|"]
     for k in models:
