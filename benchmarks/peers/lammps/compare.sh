@@ -5,6 +5,12 @@
 #
 #   benchmarks/peers/lammps/compare.sh [--mason 1e-2] [--steps 2000] [--reps 2]
 #        [--strain 0.25] [--window 0.05] [--scene FILE] [--work DIR] [--no-results]
+#        [--set KEY=VALUE]... [--dt-a DT]
+#
+#   --set overrides a key of the scene for the export and every mrf run (the
+#   soft-contact variant: --set contact.youngs_modulus='"0.1 GPa"'
+#   --set particles.magnetization=3e5 --set dipole_cutoff=... as in issue 16);
+#   --dt-a runs (a) at that dt instead of mrf's automatic one (LAMMPS's 1e-8 s).
 #
 #   0. force-law check of the LAMMPS mapping (in.check_forces) and a start-up
 #      check: dipole energy and virial stress of both codes over the first
@@ -39,6 +45,8 @@ window=0.05
 scene="$root/experiments/scenes/paper_dem_stokes.toml"
 work=""
 write_results=1
+sets=()
+dt_a=""
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --mason) mason="$2"; shift 2 ;;
@@ -49,7 +57,9 @@ while [[ $# -gt 0 ]]; do
     --scene) scene="$2"; shift 2 ;;
     --work) work="$2"; shift 2 ;;
     --no-results) write_results=0; shift ;;
-    -h|--help) sed -n '2,27p' "$0"; exit 0 ;;
+    --set) sets+=(--set "$2"); shift 2 ;;
+    --dt-a) dt_a="$2"; shift 2 ;;
+    -h|--help) sed -n '2,33p' "$0"; exit 0 ;;
     *) echo "compare.sh: unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -77,7 +87,7 @@ mrf="$build/mrf"
 prefix="$work/scene"
 # mrf's explicit scheme is the one compared step for step (its dt is the one
 # LAMMPS is given in (a)); the implicit scheme enters (b) as a second mrf entry.
-run "$mrf" export-lammps "$scene" --set "drive.mason=$mason" --set numerics.integrator=verlet_exp --out "$prefix" > "$work/export.log"
+run "$mrf" export-lammps "$scene" --set "drive.mason=$mason" --set numerics.integrator=verlet_exp "${sets[@]}" --out "$prefix" > "$work/export.log"
 pget() { awk -v k="$1" '$1=="variable" && $2==k {print $4}' "$prefix.params"; }
 dt_mrf="$(pget dt_mrf)"
 gdot="$(pget shear_rate)"
@@ -92,7 +102,7 @@ strain_for_steps() { calc "($1 - 0.5) * $gdot * $2"; }
 mrf_run() {  # name strain warmup [extra --set ...]; integrator $mrf_int (default verlet_exp)
   local name="$1" s="$2" w="$3"; shift 3
   run "$mrf" run "$scene" --set "drive.mason=$mason" --set "drive.strain=$s" \
-      --set "drive.warmup_strain=$w" --set "numerics.integrator=${mrf_int:-verlet_exp}" "$@" \
+      --set "drive.warmup_strain=$w" --set "numerics.integrator=${mrf_int:-verlet_exp}" "${sets[@]}" "$@" \
       --out "$work/$name" > "$work/$name.stdout" 2> "$work/$name.stderr"
 }
 lmp_run() {  # name nsteps dt nave thermo_every
@@ -120,21 +130,23 @@ for q in 2 4; do
 done
 
 # --- (a) throughput at equal dt ---------------------------------------------------------
+dt_eq="${dt_a:-$dt_mrf}"
 for ((r = 1; r <= reps; r++)); do
   if (( r % 2 == 1 )); then order="mrf lmp"; else order="lmp mrf"; fi
   for code in $order; do
-    echo "  [a] rep $r: $code, $steps steps at dt = $dt_mrf s"
+    echo "  [a] rep $r: $code, $steps steps at dt = $dt_eq s"
     if [[ "$code" == mrf ]]; then
-      mrf_run "a_mrf_$r" "$(strain_for_steps "$steps" "$dt_mrf")" 0 --set numerics.dt="$dt_mrf"
+      mrf_run "a_mrf_$r" "$(strain_for_steps "$steps" "$dt_eq")" 0 --set numerics.dt="$dt_eq"
     else
-      lmp_run "a_lmp_$r" "$steps" "$dt_mrf" 100 "$steps"
+      lmp_run "a_lmp_$r" "$steps" "$dt_eq" 100 "$steps"
     fi
   done
 done
 
 # --- LAMMPS' own largest stable dt ----------------------------------------------------
-# mrf prints its limits at start-up; take its expected overlap and safety factor.
-dt_basis="$(python3 - "$work/a_mrf_1.stderr" "$prefix.params" <<'EOF'
+# mrf prints its limits at start-up (the start-up run: automatic dt); take its
+# expected overlap and safety factor.
+dt_basis="$(python3 - "$work/startup.stderr" "$prefix.params" <<'EOF'
 import cmath, math, re, sys
 text = open(sys.argv[1]).read()
 par = {}
@@ -144,7 +156,7 @@ for line in open(sys.argv[2]):
         par[f[1]] = float(f[3])
 m = re.search(r"verlet_exp\s+hertz contact\s+dt < (\S+)\s+expected overlap/R (\S+)", text)
 limit_mrf, h_over_r = float(m.group(1)), float(m.group(2))
-chosen = float(re.search(r"chosen: \S+, dt = (\S+) s", text).group(1))
+chosen = float(re.search(r"chosen: \S+, (?:fixed )?dt = (\S+) s", text).group(1))
 safety = round(chosen / limit_mrf, 2)  # the limit is printed to 3 digits; mrf's dt_safety (0.5 by default)
 R, mass, k, tau = par["radius"], par["mass"], par["hertz_k"], par["tau_p"]
 h = h_over_r * R
@@ -239,7 +251,9 @@ def lmp_log(name):
         f = line.split()
         if len(f) == 8 and f[0].isdigit():
             thermo.append([float(x) for x in f])
+    nb = re.search(r"Neighbor list builds = (\d+)", t)
     return dict(loop=float(m.group(1)), steps=int(m.group(3)), atoms=int(m.group(4)),
+                builds=int(nb.group(1)) if nb else -1,
                 cpu=float(cpu.group(1)) if cpu else float("nan"), sections=sec, thermo=thermo)
 
 def mrf_sum(name):
@@ -293,12 +307,15 @@ median_a = ratios_a[len(ratios_a) // 2] if len(ratios_a) % 2 else 0.5 * (ratios_
 best_a = (n_free * steps / min(x[1] for x in rows_a)) / (n_free * steps / min(x[2] for x in rows_a))
 pairs_per_step = rows_a[0][7]["pair_evaluations_per_second"] * rows_a[0][1] / steps
 
-P(f"(a) Throughput at equal dt = {par['dt_mrf']:.4g} s, {steps} steps, serial, {n_free} free spheres (particle-steps/s = {n_free} x steps / loop wall time):")
+dt_eq = rows_a[0][7]["dt"]
+P(f"(a) Throughput at equal dt = {dt_eq:.4g} s, {steps} steps, serial, {n_free} free spheres (particle-steps/s = {n_free} x steps / loop wall time):")
 P("")
-P("| rep | mrf loop (s) | LAMMPS loop (s) | mrf particle-steps/s | LAMMPS particle-steps/s | mrf/LAMMPS | LAMMPS %CPU |")
-P("|---:|---:|---:|---:|---:|---:|---:|")
-for r, tm, tl, pm, pl, q, cpu, _ in rows_a:
-    P(f"| {r} | {tm:.2f} | {tl:.2f} | {pm:.4g} | {pl:.4g} | {q:.2f} | {cpu:.0f} |")
+P("| rep | mrf loop (s) | LAMMPS loop (s) | mrf particle-steps/s | LAMMPS particle-steps/s | mrf/LAMMPS | LAMMPS %CPU | list builds per 1000 steps mrf / LAMMPS |")
+P("|---:|---:|---:|---:|---:|---:|---:|---:|")
+for r, tm, tl, pm, pl, q, cpu, sm in rows_a:
+    bl = lmp_log(f"a_lmp_{r}")["builds"]
+    P(f"| {r} | {tm:.2f} | {tl:.2f} | {pm:.4g} | {pl:.4g} | {q:.2f} | {cpu:.0f} | "
+      f"{1000 * sm['neighbor_builds'] / steps:.1f} / {1000 * bl / steps:.1f} |")
 P("")
 P(f"Ratio mrf/LAMMPS per step: median {median_a:.2f}, best-of-{reps} times {best_a:.2f}. "
   f"Verlet-list entries per step (mrf, cut-off + skin): {pairs_per_step:.4g}; "
