@@ -60,6 +60,16 @@ int quasistatic_command(const std::string& scene_path, const std::vector<std::st
   j["stress_scale"] = r.stress_scale;  // phi mu0 M^2 (Pa)
   j["stress_wall_over_phi_mu0_m2"] = r.steady_wall.mean / r.stress_scale;
   j["stress_wall_over_phi_mu0_m2_err"] = r.steady_wall.sem / r.stress_scale;
+  // The periodic orbit (quasistatic/aqs.hpp): when the steady part repeats
+  // itself with the walls' period lz/gap, its mean over one period is the
+  // value (the block error of a repeating series is not an error bar).
+  j["orbit_period_strain"] = r.orbit_period_strain;
+  j["orbit_periodic"] = r.orbit_wall.periodic;
+  j["orbit_deviation"] = r.orbit_wall.deviation;
+  if (r.orbit_wall.period > 0) {
+    j["stress_wall_orbit_mean"] = r.orbit_wall.mean;
+    j["stress_wall_orbit_mean_over_phi_mu0_m2"] = r.orbit_wall.mean / r.stress_scale;
+  }
   j["equilibrium_bound"] = r.equilibrium_bound;
   j["force_evaluations"] = r.force_evaluations;
   j["list_builds"] = r.list_builds;

@@ -26,8 +26,12 @@ for r in rows:
                    f"{s['equilibrium_bound']}")
 if abs(float(rows[-1]["strain"]) - 0.005) > 1e-12:
     bad.append(f"last strain {rows[-1]['strain']}")
-for k in ("stress_wall", "stress_wall_err", "stress_virial", "scene_id", "stress_wall_over_phi_mu0_m2"):
+for k in ("stress_wall", "stress_wall_err", "stress_virial", "scene_id", "stress_wall_over_phi_mu0_m2",
+          "orbit_period_strain", "orbit_periodic"):
     if k not in s:
         bad.append(f"summary.json lacks {k}")
+# 5 increments of 1e-3 are far shorter than two periods lz/gap = 0.4: no orbit is claimed.
+if s.get("orbit_periodic") is not False or abs(s.get("orbit_period_strain", 0) - 32.0 / 80.0) > 1e-12:
+    bad.append(f"orbit: periodic {s.get('orbit_periodic')}, period {s.get('orbit_period_strain')}")
 print("\n".join(bad) if bad else f"mrf quasistatic: {len(rows)} minima, all checks passed")
 sys.exit(1 if bad else 0)

@@ -173,3 +173,33 @@ TEST(QuasistaticOptions, BadValuesNameTheirKey) {
 
 }  // namespace
 }  // namespace mrf
+
+namespace mrf {
+namespace {
+
+// The orbit detector on synthetic series: a transient followed by an exact
+// sawtooth of period 7 is periodic and its mean is the sawtooth's; noise of
+// 1e-3 is not periodic; a series shorter than two periods reports none.
+TEST(QuasistaticOrbit, FindsAnExactPeriodAndItsMeanAndRejectsNoise) {
+  std::vector<double> y;
+  for (int k = 0; k < 20; ++k) y.push_back(50.0 - k);  // transient
+  const double saw[7] = {10, 12, 14, 16, 18, 20, 5};
+  for (int rep = 0; rep < 5; ++rep)
+    for (double v : saw) y.push_back(v);
+  const OrbitMean o = orbit_mean(y, 20, 7, 1e-6);
+  EXPECT_TRUE(o.periodic);
+  EXPECT_EQ(o.period, 7u);
+  EXPECT_DOUBLE_EQ(o.mean, 95.0 / 7.0);
+  EXPECT_EQ(o.deviation, 0.0);
+  // A wrong period is not accepted.
+  EXPECT_FALSE(orbit_mean(y, 20, 6, 1e-6).periodic);
+  std::vector<double> noisy = y;
+  for (std::size_t k = 20; k < noisy.size(); ++k) noisy[k] *= 1.0 + 1e-3 * std::sin(static_cast<double>(k));
+  const OrbitMean n = orbit_mean(noisy, 20, 7, 1e-6);
+  EXPECT_FALSE(n.periodic);
+  EXPECT_GT(n.deviation, 1e-4);
+  EXPECT_EQ(orbit_mean(y, 20, 20, 1e-6).period, 0u);
+}
+
+}  // namespace
+}  // namespace mrf

@@ -46,6 +46,10 @@ void record(QuasistaticResult& r, const QuasistaticPoint& pt) {
   r.iterations.push_back(pt.iterations);
 }
 
+// Relative tolerance of a repeated minimum: far above the minimiser's
+// round-off, far below any physical change of the stress.
+constexpr double k_orbit_rel_tol = 1e-6;
+
 // Steady part: strain >= warmup, then the MSER-5 cut of the wall stress.
 void steady_averages(QuasistaticResult& r, double warmup) {
   std::size_t first = 0;
@@ -59,9 +63,33 @@ void steady_averages(QuasistaticResult& r, double warmup) {
   r.steady_from_strain = r.strain[first + cut];
   r.steady_wall = block_average(wall);
   r.steady_virial = block_average(vir);
+  // The period in increments, when lz/gap is a whole number of them.
+  if (r.strain.size() > 1 && r.orbit_period_strain > 0) {
+    const double inc = r.strain[1] - r.strain[0], p = r.orbit_period_strain / inc;
+    const double whole = std::round(p);
+    if (whole >= 1 && std::abs(p - whole) < 1e-6 * p)
+      r.orbit_wall = orbit_mean(r.stress_wall, first + cut, static_cast<std::size_t>(whole), k_orbit_rel_tol);
+  }
 }
 
 }  // namespace
+
+OrbitMean orbit_mean(const std::vector<double>& y, std::size_t first, std::size_t period, double rel_tol) {
+  OrbitMean o;
+  if (period == 0 || first > y.size() || y.size() - first < 2 * period) return o;
+  o.period = period;
+  const std::size_t n = y.size();
+  double scale = 0, dev = 0, sum = 0;
+  for (std::size_t k = n - period; k < n; ++k) {
+    scale = std::max({scale, std::abs(y[k]), std::abs(y[k - period])});
+    dev = std::max(dev, std::abs(y[k] - y[k - period]));
+    sum += y[k];
+  }
+  o.mean = sum / static_cast<double>(period);
+  o.deviation = scale > 0 ? dev / scale : 0.0;
+  o.periodic = o.deviation <= rel_tol;
+  return o;
+}
 
 void QuasistaticOptions::validate() const {
   require(strain_increment > 0 && strain_increment <= 0.1, "strain_increment", strain_increment,
@@ -172,6 +200,7 @@ QuasistaticResult run_quasistatic(ShearCell cell, const DemParams& p, const Quas
   r.stress_scale = static_cast<double>(s.cell.free.size()) * sphere_volume(p.radius) / box.volume() * k_mu0 *
                    std::pow(p.moment / sphere_volume(p.radius), 2);
   r.equilibrium_bound = static_cast<double>(s.cell.free.size()) * 0.5 * box.gap * fire.force_tol / box.volume();
+  r.orbit_period_strain = box.lz / box.gap;
   const auto n_inc = static_cast<std::size_t>(std::ceil(*o.strain / o.strain_increment - 1e-9));
   for (std::size_t k = 0; k <= n_inc; ++k) {
     const double strain = static_cast<double>(k) * o.strain_increment;

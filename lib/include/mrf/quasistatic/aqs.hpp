@@ -69,6 +69,19 @@ struct QuasistaticPoint {
   long iterations = 0;               // FIRE iterations of this minimisation
 };
 
+// A periodic orbit in a series sampled at equal strain steps: the walls
+// return to an image of their start every lz/gap of strain, and a
+// quasi-static run can then repeat itself exactly (reports/quasistatic/).
+struct OrbitMean {
+  bool periodic = false;  // the last `period` samples repeat the `period` before them within rel_tol
+  std::size_t period = 0; // samples; 0 when the series is shorter than two periods
+  double mean = 0;        // mean over the last whole period (the orbit's mean when periodic)
+  double deviation = 0;   // largest |y[k] - y[k - period]| over the last period, / max |y|
+};
+// Checks y[first..] for a period of `period` samples (relative tolerance
+// rel_tol of the largest |y|) and returns the mean of its last period.
+OrbitMean orbit_mean(const std::vector<double>& y, std::size_t first, std::size_t period, double rel_tol);
+
 struct QuasistaticResult {
   // One entry per accepted minimum, increment 0 first.
   std::vector<double> strain, stress_wall, stress_virial, stress_virial_magnetic, stress_virial_contact, energy,
@@ -78,6 +91,11 @@ struct QuasistaticResult {
   // transient (observe/steady_state.hpp), block-averaged over strain.
   double steady_from_strain = 0;
   BlockAverage steady_wall, steady_virial;  // Pa
+  // The wall stress over the last period lz/gap of the steady part: when
+  // the run has settled on a periodic orbit (exactly repeating minima) the
+  // block error says nothing, and this mean is the run's value.
+  double orbit_period_strain = 0;  // lz/gap
+  OrbitMean orbit_wall;
   double force_scale = 0;        // F0 (N)
   double force_tol = 0;          // N
   double stress_scale = 0;       // phi mu0 M^2 (Pa), for reports
