@@ -10,9 +10,9 @@ A case is a name, a model and ';'-separated --set overrides of the scene
 (default experiments/scenes/small_dem_stokes.toml and the cases below). A run
 whose summary.json exists is not run again, so an interrupted comparison
 resumes. The report gives per run the stresses and their difference in
-combined standard errors, and per case the seed means (error: the seed
-scatter over sqrt(n) or the largest within-run error, whichever is larger)
-and the CPU-time ratio old / new.
+combined standard errors, and per case the seed means (error: the larger of
+the seed scatter over sqrt(n) and the within-run errors combined,
+sqrt(sum err^2) / n, as mrf criterion does) and the CPU-time ratio old / new.
 """
 import argparse
 import json
@@ -83,7 +83,7 @@ def main():
 
         def mean_err(rs):
             v = [r["stress_total"] for r in rs]
-            within = max(r["stress_total_err"] for r in rs) / math.sqrt(len(rs))
+            within = math.sqrt(sum(r["stress_total_err"] ** 2 for r in rs)) / len(rs)
             scatter = statistics.stdev(v) / math.sqrt(len(v)) if len(v) > 1 else 0.0
             return statistics.mean(v), max(within, scatter)
 

@@ -44,13 +44,20 @@ double choose_skin(const SkinPolicy& policy, double range, double nonaffine_per_
 
 namespace {
 
-double ff_nonaffine(const DemPairLists& l, const FreeParticles& free, const Box& box) {
-  return max_nonaffine_displacement(free.x, l.x_ref, box, l.strain_ff);
+// The free-free list's state: unbuilt (or built for another number of
+// particles), or its largest non-affine displacement since the build.
+struct FreeFreeMotion {
+  bool unbuilt = true;
+  double nonaffine = 0;  // m
+};
+
+FreeFreeMotion ff_motion(const DemPairLists& l, const FreeParticles& free, const Box& box) {
+  if (l.builds == 0 || l.x_ref.size() != free.size() || l.ff.rows() != free.size()) return {};
+  return {false, max_nonaffine_displacement(free.x, l.x_ref, box, l.strain_ff)};
 }
 
-bool ff_stale(const DemPairLists& l, const FreeParticles& free, const Box& box) {
-  if (l.builds == 0 || l.x_ref.size() != free.size() || l.ff.rows() != free.size()) return true;
-  return 2.0 * ff_nonaffine(l, free, box) + std::abs(l.strain_ff) * (l.ff_range + l.skin) > l.skin;
+bool ff_stale(const DemPairLists& l, const FreeFreeMotion& m) {
+  return m.unbuilt || 2.0 * m.nonaffine + std::abs(l.strain_ff) * (l.ff_range + l.skin) > l.skin;
 }
 
 bool fw_stale(const DemPairLists& l, const FreeParticles& free, std::size_t n_walls, const Box& box) {
@@ -64,11 +71,10 @@ bool fw_stale(const DemPairLists& l, const FreeParticles& free, std::size_t n_wa
 // An adaptive skin is chosen from the rates since the last free-free
 // build; true when it changed (the free-wall list, built with the old
 // skin, must then be rebuilt too).
-bool adapt_skin(DemPairLists& l, const FreeParticles& free, const Box& box) {
-  if (!l.policy.adaptive || l.steps_ff <= 0 || l.x_ref.size() != free.size()) return false;
+bool adapt_skin(DemPairLists& l, const FreeFreeMotion& m) {
+  if (!l.policy.adaptive || l.steps_ff <= 0 || m.unbuilt) return false;
   const double steps = static_cast<double>(l.steps_ff);
-  const double skin =
-      choose_skin(l.policy, l.ff_range, ff_nonaffine(l, free, box) / steps, std::abs(l.strain_ff) / steps);
+  const double skin = choose_skin(l.policy, l.ff_range, m.nonaffine / steps, std::abs(l.strain_ff) / steps);
   if (skin == l.skin) return false;
   l.skin = skin;
   return true;
@@ -108,8 +114,9 @@ void advance_pair_lists(DemPairLists& lists, double d_strain) {
 
 void build_pair_lists(DemPairLists& lists, const FreeParticles& free, const WallParticles& walls,
                       const Box& box) {
-  const bool ff = ff_stale(lists, free, box);
-  const bool resized = ff && adapt_skin(lists, free, box);
+  const FreeFreeMotion m = ff_motion(lists, free, box);
+  const bool ff = ff_stale(lists, m);
+  const bool resized = ff && adapt_skin(lists, m);
   const bool fw = resized || fw_stale(lists, free, walls.size(), box) || (lists.fw_range <= 0 && !lists.fw.empty());
   if (ff) build_ff(lists, free, box);
   if (fw) build_fw(lists, free, walls, box);
@@ -124,7 +131,7 @@ void rebuild_all_pair_lists(DemPairLists& lists, const FreeParticles& free, cons
 }
 
 bool needs_rebuild(const DemPairLists& lists, const FreeParticles& free, const Box& box) {
-  return ff_stale(lists, free, box) || fw_stale(lists, free, lists.walls_ref, box);
+  return ff_stale(lists, ff_motion(lists, free, box)) || fw_stale(lists, free, lists.walls_ref, box);
 }
 
 }  // namespace mrf

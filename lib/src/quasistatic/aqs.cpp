@@ -126,7 +126,7 @@ void evaluate_forces(QuasistaticState& s) {
   ShearCell& c = s.cell;
   wrap_all(c.free.x, c.box);
   wrap_all(c.walls.x, c.box);
-  if (needs_rebuild(s.lists, c.free, c.box)) build_pair_lists(s.lists, c.free, c.walls, c.box);
+  build_pair_lists(s.lists, c.free, c.walls, c.box);  // rebuilds only the lists that may be stale
   s.sums = compute_pair_forces(s.laws, c.box, c.free, c.walls, s.lists, s.buffers);
 }
 

@@ -32,7 +32,7 @@ constexpr double k_sph_skin_over_h = 0.2;
 // An error-controlled step is at most this fraction of the averaging
 // window (drive.strain - drive.warmup_strain), so that the window holds at
 // least this many rows (one per step at most) for block averaging.
-constexpr double k_window_steps = 64;
+constexpr int k_window_steps = 64;
 
 std::string g3(double v) {
   char b[32];
@@ -59,7 +59,8 @@ StabilityLimit window_limit(const SceneConfig& c) {
   const double window = c.strain - c.warmup_strain;
   const double dt = c.shear_rate != 0 && window > 0 ? window / (k_window_steps * std::abs(c.shear_rate))
                                                     : std::numeric_limits<double>::infinity();
-  return {"averaging window", dt, "at least 64 steps in drive.strain - drive.warmup_strain"};
+  return {"averaging window", dt,
+          "at least " + std::to_string(k_window_steps) + " steps in drive.strain - drive.warmup_strain"};
 }
 
 TimeStepChoice choose_time_step(const LoadedScene& scene, const DemParams& p) {

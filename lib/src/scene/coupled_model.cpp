@@ -244,7 +244,7 @@ void CoupledModel::update_dem_forces() {
     }
   wrap_all(f.x, cell_.box);
   wrap_all(cell_.walls.x, cell_.box);
-  if (needs_rebuild(lists_, f, cell_.box)) build_pair_lists(lists_, f, cell_.walls, cell_.box);
+  build_pair_lists(lists_, f, cell_.walls, cell_.box);  // rebuilds only the lists that may be stale
   const PairSums ps = compute_dem_forces(p_, cell_.box, f, cell_.walls, lists_, buffers_);
   sums_.dem.wall_fz[0] += ps.wall_fz[0];
   sums_.dem.wall_fz[1] += ps.wall_fz[1];

@@ -67,7 +67,7 @@ void DemModel::update_forces() {
   check_finite_positions();
   wrap_all(cell_.free.x, cell_.box);
   wrap_all(cell_.walls.x, cell_.box);
-  if (needs_rebuild(lists_, cell_.free, cell_.box)) build_pair_lists(lists_, cell_.free, cell_.walls, cell_.box);
+  build_pair_lists(lists_, cell_.free, cell_.walls, cell_.box);  // rebuilds only the lists that may be stale
   sums_ = compute_dem_forces(p_, cell_.box, cell_.free, cell_.walls, lists_, buffers_);
   check_finite();
 }
