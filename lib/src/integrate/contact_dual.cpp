@@ -18,7 +18,7 @@ Vec3 pair_vector(const ContactPair& c, const std::vector<Vec3>& x, const WallPar
 }  // namespace
 
 void ContactDual::move(const std::vector<ContactPair>& pairs, const std::vector<double>& q, bool active_only,
-                       std::vector<Vec3>& y, bool contact_rows_only) {
+                       std::vector<Vec3>& y) {
   const std::vector<double>& mob = *mob_;
   const std::size_t m = active_only ? act_.size() : pairs.size();
   if (coupled_) s_.assign(y.size(), Vec3::Zero());
@@ -34,7 +34,7 @@ void ContactDual::move(const std::vector<ContactPair>& pairs, const std::vector<
       if (!pc.wall) s_[pc.k] -= f;
     }
   }
-  if (coupled_) coupled_->add(s_, coupled_scale_, y, contact_rows_only ? &act_particles_ : nullptr);
+  if (coupled_) coupled_->add(s_, coupled_scale_, y);
 }
 
 void ContactDual::add_forces(const std::vector<ContactPair>& pairs, std::vector<Vec3>& f) const {
@@ -46,29 +46,24 @@ void ContactDual::add_forces(const std::vector<ContactPair>& pairs, std::vector<
   }
 }
 
-// (A + C) p on the active set: A = G^T M G, C diagonal. With a coupled
-// mobility M = diag(mob) + s C moves every particle that shares fluid with
-// an active contact, so the product goes through move(); without, only the
-// particles of active contacts move.
+// (A + C) p on the active set: A = G^T M G, C diagonal. Only the spheres of
+// active contacts are read back, so only their rows of M G p are formed.
 void ContactDual::apply(const std::vector<ContactPair>& pairs, const std::vector<double>& p,
                         std::vector<double>& out) {
   const std::vector<double>& mob = *mob_;
-  if (coupled_) {
-    std::fill(disp_.begin(), disp_.end(), Vec3::Zero());
-    move(pairs, p, true, disp_, true);  // only the spheres of active contacts are read back
-  } else {
-    for (std::size_t a = 0; a < act_.size(); ++a) {
-      const ContactPair& c = pairs[act_[a]];
-      disp_[c.i].setZero();
-      if (!c.wall) disp_[c.k].setZero();
-    }
-    for (std::size_t a = 0; a < act_.size(); ++a) {
-      const ContactPair& c = pairs[act_[a]];
-      const Vec3 g = p[a] * n_[act_[a]];
-      disp_[c.i] += mob[c.i] * g;
-      if (!c.wall) disp_[c.k] -= mob[c.k] * g;
+  for (auto i : act_particles_) disp_[i].setZero();
+  if (coupled_) s_.assign(disp_.size(), Vec3::Zero());
+  for (std::size_t a = 0; a < act_.size(); ++a) {
+    const ContactPair& c = pairs[act_[a]];
+    const Vec3 g = p[a] * n_[act_[a]];
+    disp_[c.i] += mob[c.i] * g;
+    if (!c.wall) disp_[c.k] -= mob[c.k] * g;
+    if (coupled_) {
+      s_[c.i] += g;
+      if (!c.wall) s_[c.k] -= g;
     }
   }
+  if (coupled_) coupled_->add(s_, coupled_scale_, disp_, &act_particles_);
   out.resize(act_.size());
   for (std::size_t a = 0; a < act_.size(); ++a) {
     const std::uint32_t e = act_[a];
@@ -116,6 +111,8 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
   rhs_.resize(np);
   s_.resize(y.size());
   disp_.resize(y.size());
+  seen_.assign(y.size(), 0);
+  std::uint32_t stamp = 1;
   if (coupled_) {  // s (C_ii + C_kk - 2 C_ik) of each candidate: the diagonal of s G^T C G (Jacobi)
     crel_.resize(np);
     for (std::size_t c = 0; c < np; ++c) {
@@ -155,13 +152,13 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
       act_.push_back(static_cast<std::uint32_t>(c));
       if (std::abs(phi) > worst) worst = std::abs(phi), res.worst = pc.i;
     }
-    act_particles_.clear();
-    for (auto c : act_) {
-      act_particles_.push_back(pairs[c].i);
-      if (!pairs[c].wall) act_particles_.push_back(pairs[c].k);
-    }
-    std::sort(act_particles_.begin(), act_particles_.end());
-    act_particles_.erase(std::unique(act_particles_.begin(), act_particles_.end()), act_particles_.end());
+    act_particles_.clear();  // each sphere once, in order of first appearance (no sort: 11 % of a run)
+    for (auto c : act_)
+      for (std::uint32_t i : {pairs[c].i, pairs[c].k}) {
+        if (seen_[i] != stamp) seen_[i] = stamp, act_particles_.push_back(i);
+        if (pairs[c].wall) break;
+      }
+    ++stamp;
     y_next_ = b;
     move(pairs, lambda_, false, y_next_);
     // y was placed with the normals of the last iterate; with the normals

@@ -48,10 +48,9 @@ class ContactDual {
   void add_forces(const std::vector<ContactPair>& pairs, std::vector<Vec3>& f) const;
 
  private:
-  // y += M G q for the pair values q (all pairs, or the active set); the
-  // coupled part for every sphere, or only those of active contacts
+  // y += M G q for the pair values q (all pairs, or the active set)
   void move(const std::vector<ContactPair>& pairs, const std::vector<double>& q, bool active_only,
-            std::vector<Vec3>& y, bool contact_rows_only = false);
+            std::vector<Vec3>& y);
   // (A + C) p on the active set
   void apply(const std::vector<ContactPair>& pairs, const std::vector<double>& p, std::vector<double>& out);
   long solve_cg(const std::vector<ContactPair>& pairs, double rtol);
@@ -61,7 +60,8 @@ class ContactDual {
   std::vector<double> lambda_, comp_, rhs_, crel_;
   std::vector<Vec3> n_;
   std::vector<std::uint32_t> act_;           // active pairs
-  std::vector<std::uint32_t> act_particles_;  // the spheres of active pairs, sorted
+  std::vector<std::uint32_t> act_particles_;  // the spheres of active pairs, each once
+  std::vector<std::uint32_t> seen_;           // per sphere: the iteration that listed it in act_particles_
   std::vector<double> d_, r_, diag_, dq_;           // CG on the active set: solution, right-hand side, Jacobi diagonal
   PcgScratch<double> cg_;
   std::vector<Vec3> s_, y_next_, disp_;      // per particle: G q, positions with the new normals, M G q
