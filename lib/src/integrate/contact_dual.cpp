@@ -152,12 +152,16 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
       act_.push_back(static_cast<std::uint32_t>(c));
       if (std::abs(phi) > worst) worst = std::abs(phi), res.worst = pc.i;
     }
-    act_particles_.clear();  // each sphere once, in order of first appearance (no sort: 11 % of a run)
-    for (auto c : act_)
-      for (std::uint32_t i : {pairs[c].i, pairs[c].k}) {
-        if (seen_[i] != stamp) seen_[i] = stamp, act_particles_.push_back(i);
-        if (pairs[c].wall) break;
-      }
+    // The spheres of active contacts, ascending (the coupled products read
+    // their rows in this order): marked, then collected by one pass, which
+    // costs less than sorting the contacts' ends (11 % of a model-1 run).
+    for (auto c : act_) {
+      seen_[pairs[c].i] = stamp;
+      if (!pairs[c].wall) seen_[pairs[c].k] = stamp;
+    }
+    act_particles_.clear();
+    for (std::uint32_t i = 0; i < seen_.size(); ++i)
+      if (seen_[i] == stamp) act_particles_.push_back(i);
     ++stamp;
     y_next_ = b;
     move(pairs, lambda_, false, y_next_);

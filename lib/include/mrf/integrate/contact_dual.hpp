@@ -60,7 +60,7 @@ class ContactDual {
   std::vector<double> lambda_, comp_, rhs_, crel_;
   std::vector<Vec3> n_;
   std::vector<std::uint32_t> act_;           // active pairs
-  std::vector<std::uint32_t> act_particles_;  // the spheres of active pairs, each once
+  std::vector<std::uint32_t> act_particles_;  // the spheres of active pairs, ascending
   std::vector<std::uint32_t> seen_;           // per sphere: the iteration that listed it in act_particles_
   std::vector<double> d_, r_, diag_, dq_;           // CG on the active set: solution, right-hand side, Jacobi diagonal
   PcgScratch<double> cg_;

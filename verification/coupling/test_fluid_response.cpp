@@ -1,0 +1,113 @@
+// The coupled mobility C of coupling/fluid_response.hpp against its
+// definition C_ij = sum_a m W_ia W_aj / (rho_a^2 s_i s_j), formed from the
+// pair list directly: the product, its symmetry, C_ii and C_ik, and the
+// product restricted to some rows.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "mrf/coupling/exchange.hpp"
+#include "mrf/coupling/fluid_response.hpp"
+
+namespace mrf {
+namespace {
+
+struct Coupled {
+  Box box{};
+  std::vector<Vec3> dem, sph;
+  std::vector<CouplingPair> pairs;
+  std::vector<double> rho, s;
+  double mass = 0, h = 0;
+  FluidResponse response;
+};
+
+// A periodic slab (x walls at 0 and gap, y and z periodic) with SPH
+// particles on a jittered lattice and DEM particles at random.
+Coupled make_setup(std::size_t n_dem, unsigned seed) {
+  Coupled u;
+  const double gap = 60e-6, ly = 40e-6, lz = 40e-6, dx = 8e-6;
+  u.box = Box{gap, ly, lz};
+  u.h = 1.3 * dx;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (double x = 0; x <= gap + 1e-12; x += dx)
+    for (double y = 0; y < ly - 1e-12; y += dx)
+      for (double z = 0; z < lz - 1e-12; z += dx)
+        u.sph.push_back(Vec3(x, y + 0.1 * dx * unit(rng), z + 0.1 * dx * unit(rng)));
+  for (std::size_t i = 0; i < n_dem; ++i)
+    u.dem.push_back(Vec3(gap * (0.1 + 0.8 * unit(rng)), ly * unit(rng), lz * unit(rng)));
+  u.pairs = coupling_pairs(u.dem, u.sph, u.box, u.h);
+  u.mass = 1000.0 * dx * dx * dx;
+  u.rho.resize(u.sph.size());
+  for (double& r : u.rho) r = 700.0 + 300.0 * unit(rng);  // superficial densities
+  u.s.assign(n_dem, 0.0);
+  for (const CouplingPair& q : u.pairs) u.s[q.i] += u.mass / u.rho[q.a] * q.w;
+  u.response.set(n_dem, u.pairs, u.s, u.rho, u.mass);
+  return u;
+}
+
+std::vector<Vec3> dense_product(const Coupled& u, const std::vector<Vec3>& f) {
+  std::vector<Vec3> z(u.sph.size(), Vec3::Zero()), y(u.dem.size(), Vec3::Zero());
+  for (const CouplingPair& q : u.pairs) z[q.a] += q.w / (u.rho[q.a] * u.s[q.i]) * f[q.i];
+  for (const CouplingPair& q : u.pairs) y[q.i] += u.mass * q.w / (u.rho[q.a] * u.s[q.i]) * z[q.a];
+  return y;
+}
+
+double largest(const std::vector<Vec3>& v) {
+  double m = 0;
+  for (const Vec3& x : v) m = std::max(m, x.norm());
+  return m;
+}
+
+TEST(FluidResponse, ProductMatchesTheDefinitionAndIsSymmetric) {
+  Coupled u = make_setup(60, 3);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> g(0.0, 1e-9);
+  std::vector<Vec3> f(u.dem.size()), q(u.dem.size());
+  for (auto& v : f) v = Vec3(g(rng), g(rng), g(rng));
+  for (auto& v : q) v = Vec3(g(rng), g(rng), g(rng));
+  std::vector<Vec3> y(u.dem.size(), Vec3::Zero());
+  u.response.add(f, 1.0, y);
+  const std::vector<Vec3> ref = dense_product(u, f);
+  for (std::size_t i = 0; i < y.size(); ++i) EXPECT_LE((y[i] - ref[i]).norm(), 1e-12 * largest(ref)) << i;
+  // q . C f = f . C q, and C_ii, C_ik as the product of unit forces gives
+  std::vector<Vec3> cq(u.dem.size(), Vec3::Zero());
+  u.response.add(q, 1.0, cq);
+  double qcf = 0, fcq = 0;
+  for (std::size_t i = 0; i < y.size(); ++i) qcf += q[i].dot(y[i]), fcq += f[i].dot(cq[i]);
+  EXPECT_NEAR(qcf, fcq, 1e-12 * std::abs(qcf));
+  std::vector<Vec3> e(u.dem.size(), Vec3::Zero()), ce(u.dem.size(), Vec3::Zero());
+  e[7] = Vec3(1, 0, 0);
+  u.response.add(e, 1.0, ce);
+  EXPECT_NEAR(u.response.diagonal(7), ce[7].x(), 1e-12 * ce[7].x());
+  for (std::size_t k : {0u, 8u, 31u}) EXPECT_NEAR(u.response.coupling(k, 7), ce[k].x(), 1e-12 * ce[7].x()) << k;
+}
+
+// The rows variant (the contact solve reads back the spheres in contact
+// only) gives those rows of the full product and leaves the others alone.
+TEST(FluidResponse, RowsGiveTheRowsOfTheFullProduct) {
+  Coupled u = make_setup(90, 11);
+  std::mt19937 rng(13);
+  std::normal_distribution<double> g(0.0, 1e-9);
+  std::vector<Vec3> f(u.dem.size(), Vec3::Zero());
+  for (std::size_t j = 0; j < u.dem.size(); j += 5) f[j] = Vec3(g(rng), g(rng), g(rng));
+  std::vector<Vec3> full(u.dem.size(), Vec3::Zero());
+  u.response.add(f, 2.5, full);
+  const double scale = largest(full);
+  ASSERT_GT(scale, 0.0);
+  const std::vector<std::uint32_t> rows = {1, 4, 10, 44};
+  std::vector<Vec3> part(u.dem.size(), Vec3::Zero());
+  u.response.add(f, 2.5, part, &rows);
+  for (std::size_t i = 0; i < full.size(); ++i) {
+    if (std::find(rows.begin(), rows.end(), i) != rows.end())
+      EXPECT_LE((full[i] - part[i]).norm(), 1e-13 * scale) << i;
+    else
+      EXPECT_EQ(part[i].norm(), 0.0) << i;
+  }
+}
+
+}  // namespace
+}  // namespace mrf
