@@ -1,10 +1,16 @@
-# Project-wide warning and sanitizer flags, applied through an interface target.
+# Project-wide warning, sanitizer and floating-point flags, applied through an interface target.
 add_library(mrf_flags INTERFACE)
 target_compile_options(mrf_flags INTERFACE -Wall -Wextra -Wpedantic -Wshadow -Wconversion
   -Wno-sign-conversion)
 if(MRF_WERROR)
   target_compile_options(mrf_flags INTERFACE -Werror)
 endif()
+# sqrt need not set errno and floating-point operations need not trap
+# (nothing reads errno or enables FP exceptions; NaN is detected by value):
+# without these a sqrt is a call with a branch and a comparison cannot be
+# turned into a mask, so the pair kernel's loop (dem_forces.cpp) does not
+# vectorise. Neither flag changes a computed value.
+target_compile_options(mrf_flags INTERFACE -fno-math-errno -fno-trapping-math)
 if(MRF_NATIVE)
   target_compile_options(mrf_flags INTERFACE -march=native)
 endif()

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <tuple>
 
 #include "mrf/forces/dipole.hpp"
@@ -272,6 +273,42 @@ TEST(PairLoop, FlippedSignEvaluatorFailsTheCheck) {
   const PairSums sd = run_loop(bad_dipole, s, 1);
   EXPECT_GT(max_force_deviation(s.cell.free.f, ref), 1e6 * k_tol);
   EXPECT_GT(rel(sd.virial_mag_xz, ref.s.virial_mag_xz, ref.scale.virial_mag_xz), 1e6 * k_tol);
+}
+
+// The vectorised kernel (scene/pair_kernel_simd.cpp, Highway, the best
+// instruction set of this machine) against the scalar loop free_rows on the
+// same rows: each pair's force is the same expression, so the forces and
+// sums differ only by the order of the row sums, to round-off; the overlap
+// is a maximum of the same values, so it is equal. The configurations have
+// rows of every length, so both the vector body and the scalar tail run.
+TEST(PairLoop, VectorKernelEqualsTheScalarLoop) {
+  std::printf("pair kernel target: %s\n", pair_kernel_target());
+  for (std::uint64_t seed : {3u, 8u}) {
+    Case s = random_case(seed, 1e6, false);
+    const Reference ref = brute_force(s);
+    ASSERT_GT(ref.ff_contacts, 20);
+    const DemPairLaws<> laws = dem_pair_laws(s.p);
+    const std::size_t n = s.cell.free.size(), rows = s.lists.ff.rows();
+    std::vector<Vec3> f_scalar(n, Vec3::Zero()), f_vector(n, Vec3::Zero());
+    PairSums scalar, vector;
+    detail::free_rows<true, false>(laws, s.cell.box, s.cell.free.x, s.lists.ff, 0, rows, f_scalar, scalar);
+    detail::free_rows_simd(laws, s.cell.box, s.cell.free.x, s.lists.ff, 0, rows, f_vector, vector);
+    double worst = 0;
+    for (std::size_t i = 0; i < n; ++i) worst = std::max(worst, (f_vector[i] - f_scalar[i]).norm() / ref.f_scale[i]);
+    EXPECT_LT(worst, 1e-14);
+    EXPECT_LT(rel(vector.virial_mag_xz, scalar.virial_mag_xz, ref.scale.virial_mag_xz), 1e-14);
+    EXPECT_LT(rel(vector.virial_con_xz, scalar.virial_con_xz, ref.scale.virial_con_xz), 1e-14);
+    EXPECT_LT(rel(vector.energy_dipole, scalar.energy_dipole, ref.scale.energy_dipole), 1e-14);
+    EXPECT_LT(rel(vector.energy_hertz, scalar.energy_hertz, ref.scale.energy_hertz), 1e-14);
+    EXPECT_EQ(vector.max_overlap, scalar.max_overlap);
+    EXPECT_GT(vector.max_overlap, 0.0);
+    // and a force that is wrong by one pair's contact is seen
+    std::vector<Vec3> f_missing = f_vector;
+    f_missing[s.lists.ff.k[0]] += hertz_pair_force(Vec3(2 * R - 1e-8, 0, 0), 2 * R, s.p.hertz_k);
+    double moved = 0;
+    for (std::size_t i = 0; i < n; ++i) moved = std::max(moved, (f_missing[i] - f_scalar[i]).norm() / ref.f_scale[i]);
+    EXPECT_GT(moved, 1e-6);
+  }
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // Fixed point dipoles, REFERENCE.md §1 (paper Eq. 3). Pure functions, SI.
 // Pair convention: r_ik = r_i - r_k, the functions return the force on i.
 #pragma once
+#include "mrf/forces/generic_laws.hpp"
 #include "mrf/vec.hpp"
 
 namespace mrf {
@@ -40,12 +41,7 @@ struct DipoleX {
 
   // Sets f to the force on i (N); returns (1 - 3c^2)/r^3 (1/m^3).
   double eval(double dx, double dy, double dz, double inv_r, Vec3& f) const {
-    const double inv_r2 = inv_r * inv_r;
-    const double c = dx * inv_r, c2 = c * c;
-    const double s = pref * inv_r2 * inv_r2;       // pref / r^4
-    const double a = s * (1.0 - 5.0 * c2) * inv_r;  // radial part / r
-    f = Vec3(a * dx + 2.0 * s * c, a * dy, a * dz);
-    return (1.0 - 3.0 * c2) * inv_r2 * inv_r;
+    return dipole_x_law(pref, dx, dy, dz, inv_r, f.x(), f.y(), f.z(), [](double v) { return v; });
   }
   // J m^3: turns a sum of eval() returns into an energy.
   double energy_scale() const { return pref / 3.0; }

@@ -2,6 +2,7 @@
 #pragma once
 #include <cmath>
 
+#include "mrf/forces/generic_laws.hpp"
 #include "mrf/vec.hpp"
 
 namespace mrf {
@@ -22,8 +23,9 @@ struct HertzValue {
   double energy;  // J
 };
 inline HertzValue hertz_law(double overlap, double k) {
-  const double sh = std::sqrt(overlap);
-  return {k * overlap * sh, 0.4 * k * overlap * overlap * sh};
+  HertzValue v;
+  hertz_law_t(overlap, k, v.force, v.energy, [](double x) { return x; }, [](double x) { return std::sqrt(x); });
+  return v;
 }
 
 // Magnitude of the repulsive force (N) at overlap h (m); zero without overlap.

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <array>
 #include <cstddef>
+#include <type_traits>
 #include <vector>
 
 #include "mrf/box.hpp"
@@ -58,6 +59,10 @@ DemPairLaws<> dem_pair_laws(const DemParams& p);
 template <class Dipole, class Contact>
 PairSums compute_pair_forces(const DemPairLaws<Dipole, Contact>& laws, const Box& box, FreeParticles& free,
                              const WallParticles& walls, const DemPairLists& lists, ForceBuffers& buf);
+
+// The instruction set the vectorised pair kernel runs on here ("AVX3" for
+// AVX-512, "AVX2", "SSE4", ...).
+const char* pair_kernel_target();
 
 // The scene's laws: compute_pair_forces(dem_pair_laws(p), ...).
 PairSums compute_dem_forces(const DemParams& p, const Box& box, FreeParticles& free,
@@ -166,6 +171,11 @@ void wall_pairs(const DemPairLaws<Dipole, Contact>& laws, const Box& box, const 
   }
 }
 
+// free_rows<true, false> of the scene's laws on the vector units, the best
+// instruction set of the machine chosen at run time (pair_kernel_simd.cpp).
+void free_rows_simd(const DemPairLaws<>& laws, const Box& box, const std::vector<Vec3>& x, const PairRows& rows,
+                    std::size_t row_begin, std::size_t row_end, std::vector<Vec3>& f, PairSums& s);
+
 template <class Dipole, class Contact>
 void pair_share(const DemPairLaws<Dipole, Contact>& laws, const Box& box, const FreeParticles& free,
                 const WallParticles& walls, const DemPairLists& lists, int t, int nt, std::vector<Vec3>& f,
@@ -173,8 +183,12 @@ void pair_share(const DemPairLaws<Dipole, Contact>& laws, const Box& box, const 
   const std::size_t r0 = row_chunk(lists.ff, t, nt), r1 = row_chunk(lists.ff, t + 1, nt);
   if (!laws.magnetic)
     free_rows<false, false>(laws, box, free.x, lists.ff, r0, r1, f, s);
-  else if (laws.dipole_cutoff >= laws.contact.sum_radii)
-    free_rows<true, false>(laws, box, free.x, lists.ff, r0, r1, f, s);
+  else if (laws.dipole_cutoff >= laws.contact.sum_radii) {
+    if constexpr (std::is_same_v<Dipole, DipoleX> && std::is_same_v<Contact, HertzPair>)
+      free_rows_simd(laws, box, free.x, lists.ff, r0, r1, f, s);
+    else
+      free_rows<true, false>(laws, box, free.x, lists.ff, r0, r1, f, s);
+  }
   else
     free_rows<true, true>(laws, box, free.x, lists.ff, r0, r1, f, s);
   const std::size_t n = lists.fw.size();

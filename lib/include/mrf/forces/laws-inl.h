@@ -1,0 +1,34 @@
+// The pair laws that both the scalar loops and the vectorised kernel run,
+// written once for any arithmetic type T: double, or a SIMD vector whose
+// lanes are pairs. num(v) makes the constant v a T.
+//
+// No include guard, on purpose: mrf/forces/generic_laws.hpp includes this
+// file inside namespace mrf (the scalar laws), and scene/pair_kernel_simd.cpp
+// inside each of Highway's per-target namespaces, so that the vector
+// instantiations are compiled with that target's instruction set (a template
+// defined outside the target region could not inline its intrinsics).
+// Templates only, and no #include.
+
+// Dipole force of equal moments along +x (REFERENCE.md Eq. 3): sets
+// (fx, fy, fz) to the force on i (N) at separation (dx, dy, dz) with
+// 1/r = inv_r; returns (1 - 3c^2)/r^3 (1/m^3).
+template <class T, class Num>
+inline T dipole_x_law(T pref, T dx, T dy, T dz, T inv_r, T& fx, T& fy, T& fz, Num num) {
+  const T inv_r2 = inv_r * inv_r;
+  const T c = dx * inv_r, c2 = c * c;
+  const T s = pref * inv_r2 * inv_r2;                 // pref / r^4
+  const T a = s * (num(1.0) - num(5.0) * c2) * inv_r;  // radial part / r
+  fx = a * dx + num(2.0) * s * c;
+  fy = a * dy;
+  fz = a * dz;
+  return (num(1.0) - num(3.0) * c2) * inv_r2 * inv_r;
+}
+
+// Hertz (REFERENCE.md Eq. 2): force k h^{3/2} and energy (2/5) k h^{5/2}
+// at overlap h >= 0.
+template <class T, class Num, class Sqrt>
+inline void hertz_law_t(T overlap, T k, T& force, T& energy, Num num, Sqrt sqrt_of) {
+  const T sh = sqrt_of(overlap);
+  force = k * overlap * sh;
+  energy = num(0.4) * k * overlap * overlap * sh;
+}

@@ -1,0 +1,169 @@
+// The free-free rows of the scene's pair laws (DipoleX + HertzPair, every
+// pair in range inside the dipole cut-off) on the vector units, with Google
+// Highway: compiled for every instruction set Highway targets on this
+// architecture (AVX-512, AVX2 + FMA, SSE4, ...), the best one the machine
+// has chosen at the first call (HWY_DYNAMIC_DISPATCH), so one binary runs at
+// full width everywhere.
+//
+// A row's partners are taken a vector at a time: their coordinates gathered
+// from the packed Vec3 array, the laws of forces/ (dipole_x_law,
+// hertz_law_t) evaluated on whole vectors, a pair beyond the range masked
+// out, and the partners' forces gathered, decremented and scattered back (a
+// row's partners are distinct, so lanes never collide). The Hertz law runs on
+// max(h, 0), which gives 0 without overlap, so there is no branch. The tail
+// of a row shorter than a vector runs the same laws on doubles. Each pair's
+// force is the scalar loop's to the last bit (the same operations in the
+// same order, no contraction); the row sums run in another order, so the
+// totals agree with free_rows to round-off
+// (verification/forces/test_pair_kernel_simd.cpp).
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "scene/pair_kernel_simd.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+#include <hwy/highway.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "mrf/scene/dem_forces.hpp"
+
+HWY_BEFORE_NAMESPACE();
+namespace mrf {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+#include "mrf/forces/laws-inl.h"  // the laws, compiled for this target
+
+// Sums of a row or of a share of rows.
+struct KernelSums {
+  double vir_mag = 0, e_dip = 0, vir_con = 0, e_hertz = 0, max_h = 0;
+};
+
+// One pair on doubles (the tail of a row): the scalar loop of free_rows.
+inline void scalar_pair(const DipoleX& dipole, double k_hertz, double two_r, double range2, const MinImageYZ& mi,
+                        double xi, double yi, double zi, const double* xk, double* fk, double& fx, double& fy,
+                        double& fz, KernelSums& s) {
+  const double dx = xi - xk[0];
+  const double dy = mi.wrap_y(yi - xk[1]);
+  const double dz = mi.wrap_z(zi - xk[2]);
+  const double r2 = dx * dx + dy * dy + dz * dz;
+  if (r2 >= range2) return;
+  const auto num = [](double v) { return v; };
+  const double inv_r = 1.0 / std::sqrt(r2);
+  double gx, gy, gz;
+  s.e_dip += dipole_x_law(dipole.pref, dx, dy, dz, inv_r, gx, gy, gz, num);
+  s.vir_mag += dx * gz;
+  const double h = two_r - r2 * inv_r;
+  if (h > 0) {
+    double force, energy;
+    hertz_law_t(h, k_hertz, force, energy, num, [](double v) { return std::sqrt(v); });
+    const double f_over_r = force * inv_r;
+    s.vir_con += dx * (f_over_r * dz);
+    s.e_hertz += energy;
+    s.max_h = std::max(s.max_h, h);
+    gx += f_over_r * dx, gy += f_over_r * dy, gz += f_over_r * dz;
+  }
+  fx += gx, fy += gy, fz += gz;
+  fk[0] -= gx, fk[1] -= gy, fk[2] -= gz;
+}
+
+void FreeRows(const DemPairLaws<>& laws, const Box& box, const std::vector<Vec3>& x, const PairRows& rows,
+              std::size_t row_begin, std::size_t row_end, std::vector<Vec3>& f, PairSums& out) {
+  using D = hn::ScalableTag<double>;
+  const D d;
+  const hn::RebindToSigned<D> di;                 // int64 lanes: the gather indices
+  const hn::Rebind<std::uint32_t, D> du;          // the list's uint32 partner indices
+  const hn::RebindToUnsigned<D> du64;
+  const std::size_t lanes = hn::Lanes(d);
+  const DipoleX dipole = laws.dipole;
+  const double k_hertz = laws.contact.k, two_r = laws.contact.sum_radii;
+  const double range2 = std::max(laws.dipole_cutoff * laws.dipole_cutoff, two_r * two_r);
+  const MinImageYZ mi(box);
+  const auto num = [&d](double v) { return hn::Set(d, v); };
+  const auto vsqrt = [](hn::Vec<D> v) { return hn::Sqrt(v); };
+  const auto pref = hn::Set(d, dipole.pref), vk = hn::Set(d, k_hertz), vtwo_r = hn::Set(d, two_r);
+  const auto vrange2 = hn::Set(d, range2), vcontact2 = hn::Set(d, two_r * two_r), zero = hn::Zero(d);
+  const auto one = hn::Set(d, 1.0);
+  const auto ly = hn::Set(d, mi.ly), inv_ly = hn::Set(d, mi.inv_ly), lz = hn::Set(d, mi.lz), inv_lz = hn::Set(d, mi.inv_lz);
+  const auto magic = hn::Set(d, 6755399441055744.0);  // MinImageYZ::round_nearest
+  const std::uint32_t* ks = rows.k.data();
+  const double* xs = x.data()->data();  // Vec3: three packed doubles
+  double* fs = f.data()->data();
+  KernelSums s;
+  s.max_h = out.max_overlap;
+  auto vir_mag = zero, e_dip = zero, vir_con = zero, e_hertz = zero, max_h = zero;
+  for (std::size_t i = row_begin; i < row_end; ++i) {
+    const double xi = xs[3 * i], yi = xs[3 * i + 1], zi = xs[3 * i + 2];
+    const auto vxi = hn::Set(d, xi), vyi = hn::Set(d, yi), vzi = hn::Set(d, zi);
+    auto fx = zero, fy = zero, fz = zero;
+    std::size_t n = rows.start[i];
+    const std::size_t end = rows.start[i + 1];
+    for (; n + lanes <= end; n += lanes) {
+      const auto kk = hn::BitCast(di, hn::PromoteTo(du64, hn::LoadU(du, ks + n)));
+      const auto k3 = hn::Add(hn::Add(kk, kk), kk);  // 3 k: x of partner k
+      const auto dx = hn::Sub(vxi, hn::GatherIndex(d, xs, k3));
+      auto dy = hn::Sub(vyi, hn::GatherIndex(d, xs + 1, k3));
+      auto dz = hn::Sub(vzi, hn::GatherIndex(d, xs + 2, k3));
+      dy = hn::Sub(dy, hn::Mul(ly, hn::Sub(hn::Add(hn::Mul(dy, inv_ly), magic), magic)));
+      dz = hn::Sub(dz, hn::Mul(lz, hn::Sub(hn::Add(hn::Mul(dz, inv_lz), magic), magic)));
+      const auto r2 = hn::Add(hn::Add(hn::Mul(dx, dx), hn::Mul(dy, dy)), hn::Mul(dz, dz));
+      const auto in_range = hn::Lt(r2, vrange2);
+      const auto inv_r = hn::Div(one, hn::Sqrt(r2));
+      hn::Vec<D> gx, gy, gz;
+      const auto ed = dipole_x_law(pref, dx, dy, dz, inv_r, gx, gy, gz, num);
+      e_dip = hn::Add(e_dip, hn::IfThenElseZero(in_range, ed));
+      vir_mag = hn::Add(vir_mag, hn::IfThenElseZero(in_range, hn::Mul(dx, gz)));
+      if (!hn::AllFalse(d, hn::Lt(r2, vcontact2))) {  // contacts are rare: most vectors skip the Hertz law
+        const auto h = hn::Max(hn::Sub(vtwo_r, hn::Mul(r2, inv_r)), zero);
+        hn::Vec<D> force, energy;
+        hertz_law_t(h, vk, force, energy, num, vsqrt);
+        const auto f_over_r = hn::Mul(force, inv_r);
+        vir_con = hn::Add(vir_con, hn::Mul(dx, hn::Mul(f_over_r, dz)));
+        e_hertz = hn::Add(e_hertz, energy);
+        max_h = hn::Max(max_h, h);
+        gx = hn::Add(gx, hn::Mul(f_over_r, dx));
+        gy = hn::Add(gy, hn::Mul(f_over_r, dy));
+        gz = hn::Add(gz, hn::Mul(f_over_r, dz));
+      }
+      gx = hn::IfThenElseZero(in_range, gx);
+      gy = hn::IfThenElseZero(in_range, gy);
+      gz = hn::IfThenElseZero(in_range, gz);
+      fx = hn::Add(fx, gx), fy = hn::Add(fy, gy), fz = hn::Add(fz, gz);
+      hn::ScatterIndex(hn::Sub(hn::GatherIndex(d, fs, k3), gx), d, fs, k3);
+      hn::ScatterIndex(hn::Sub(hn::GatherIndex(d, fs + 1, k3), gy), d, fs + 1, k3);
+      hn::ScatterIndex(hn::Sub(hn::GatherIndex(d, fs + 2, k3), gz), d, fs + 2, k3);
+    }
+    double sx = hn::GetLane(hn::SumOfLanes(d, fx)), sy = hn::GetLane(hn::SumOfLanes(d, fy)),
+           sz = hn::GetLane(hn::SumOfLanes(d, fz));
+    for (; n < end; ++n) {
+      const std::size_t k = 3 * static_cast<std::size_t>(ks[n]);
+      scalar_pair(dipole, k_hertz, two_r, range2, mi, xi, yi, zi, xs + k, fs + k, sx, sy, sz, s);
+    }
+    fs[3 * i] += sx, fs[3 * i + 1] += sy, fs[3 * i + 2] += sz;
+  }
+  out.virial_mag_xz += s.vir_mag + hn::GetLane(hn::SumOfLanes(d, vir_mag));
+  out.energy_dipole += dipole.energy_scale() * (s.e_dip + hn::GetLane(hn::SumOfLanes(d, e_dip)));
+  out.virial_con_xz += s.vir_con + hn::GetLane(hn::SumOfLanes(d, vir_con));
+  out.energy_hertz += s.e_hertz + hn::GetLane(hn::SumOfLanes(d, e_hertz));
+  out.max_overlap = std::max(s.max_h, hn::GetLane(hn::MaxOfLanes(d, max_h)));
+}
+
+const char* TargetName() { return hwy::TargetName(HWY_TARGET); }
+
+}  // namespace HWY_NAMESPACE
+}  // namespace mrf
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace mrf {
+HWY_EXPORT(FreeRows);
+HWY_EXPORT(TargetName);
+
+namespace detail {
+void free_rows_simd(const DemPairLaws<>& laws, const Box& box, const std::vector<Vec3>& x, const PairRows& rows,
+                    std::size_t row_begin, std::size_t row_end, std::vector<Vec3>& f, PairSums& s) {
+  HWY_DYNAMIC_DISPATCH(FreeRows)(laws, box, x, rows, row_begin, row_end, f, s);
+}
+}  // namespace detail
+
+const char* pair_kernel_target() { return HWY_DYNAMIC_DISPATCH(TargetName)(); }
+}  // namespace mrf
+#endif
