@@ -1,6 +1,7 @@
 // Gap-spanning clusters (observe/structure.hpp): chains built by hand whose
 // connectivity is known, across the touch allowance and the periodic image.
 #include "mrf/observe/structure.hpp"
+#include "mrf/scene/run_series.hpp"
 
 #include <gtest/gtest.h>
 
@@ -68,6 +69,27 @@ TEST(Structure, SpheresJoinAcrossThePeriodicBoundaries) {
     c.free.x.back() = b;
     EXPECT_EQ(cluster_stats(c, R).clusters, 4u) << axis;
   }
+}
+
+// The structure is sampled at most once per k_structure_sample_strain of
+// rows, and the rows that do not sample it leave its mean alone.
+TEST(Structure, SampledAtMostOncePerStructureStrain) {
+  EXPECT_EQ(structure_stride(0.015), 1);    // a sweep's rows: every one
+  EXPECT_EQ(structure_stride(1e-3), 1);
+  EXPECT_EQ(structure_stride(2.5e-5), 40);  // one row per step of a short benchmark run
+  EXPECT_EQ(structure_stride(3e-4), 4);
+  EXPECT_EQ(structure_stride(0.0), 1);      // no shear: every row
+  StressSeries series;
+  SeriesRow row;
+  row.n = 1;
+  for (int r = 0; r < 40; ++r) {
+    row.clusters.spanning_fraction = r % 4 == 0 ? 0.5 : 0.9;  // 0.9 only on the rows that skip it
+    series.push(row, r % 4 == 0);
+  }
+  RunSummary s;
+  series.finish(s);
+  EXPECT_EQ(series.rows(), 40u);
+  EXPECT_DOUBLE_EQ(s.extra.at("spanning_fraction"), 0.5);
 }
 
 }  // namespace

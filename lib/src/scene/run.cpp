@@ -32,6 +32,7 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();
   auto last_report = t0;
   const double row_time = static_cast<double>(every) * s.dt;  // adaptive: s.dt is the largest step
+  const long structure_every = structure_stride(row_time * std::abs(c.shear_rate));
   long n = st.n;
   auto running = [&] { return adaptive ? model.time() < t_end * (1 - 1e-12) : n < built.planned_steps; };
   while (running()) {
@@ -48,8 +49,9 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
     st.max_overlap = std::max(st.max_overlap, row.max_overlap);
     if (files.series.is_open()) write_series_row(files.series, model.time(), strain, row, c.radius);
     if (st.row_start * c.shear_rate >= c.warmup_strain * (1 - 1e-12)) {  // whole rows after warm-up
-      row.clusters = cluster_stats(model.cell(), c.radius);
-      st.se.push(row);
+      const bool structure = st.se.rows() % structure_every == 0;
+      if (structure) row.clusters = cluster_stats(model.cell(), c.radius);
+      st.se.push(row, structure);
     }
     row = SeriesRow{};
     st.row_start = model.time();

@@ -7,6 +7,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -41,7 +42,12 @@ void SeriesRow::add(const PairSums& p, const Box& box, double fluid_stress, doub
   n += w;
 }
 
-void StressSeries::push(const SeriesRow& r) {
+long structure_stride(double row_strain) {
+  if (!(row_strain > 0)) return 1;
+  return std::max(1L, static_cast<long>(std::ceil(k_structure_sample_strain / row_strain * (1 - 1e-9))));
+}
+
+void StressSeries::push(const SeriesRow& r, bool with_structure) {
   const double k = 1.0 / r.n;
   const double tp = r.particles * k, tf = r.fluid * k, vm = r.vir_mag * k, vc = r.vir_con * k;
   total_.push_back(tp + tf);
@@ -53,6 +59,7 @@ void StressSeries::push(const SeriesRow& r) {
   diff_.push_back(tp - vm - vc);
   vir_fluid_.push_back(r.vir_fluid * k);
   vir_total_.push_back(vm + vc + r.vir_fluid * k);
+  if (!with_structure) return;
   spanning_.push_back(r.clusters.spanning_fraction);
   wall_clusters_.push_back(r.clusters.wall_fraction);
 }

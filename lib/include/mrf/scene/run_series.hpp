@@ -33,9 +33,21 @@ struct SeriesRow {
 };
 
 // Row means after the warm-up, block-averaged at the end (observe/block_average).
+// The structure (cluster statistics, the cost of a cell-list pass) is
+// sampled at most once per this much strain: finer rows (a short benchmark
+// run writes one per step) would spend more on it than on the dynamics, and
+// the block average of the structure's error bar needs decorrelated samples,
+// not more of them.
+inline constexpr double k_structure_sample_strain = 1e-3;
+// Rows between two structure samples for rows of `row_strain` each.
+long structure_stride(double row_strain);
+
 class StressSeries {
  public:
-  void push(const SeriesRow& row);
+  // with_structure: row.clusters was measured (see structure_stride).
+  void push(const SeriesRow& row, bool with_structure = true);
+  // Rows pushed so far.
+  std::size_t rows() const { return total_.size(); }
   // Fills stress_total, stress_particles, stress_fluid (mean), stress_virial
   // (particle pair virial; the fluid part is stress_fluid in every model),
   // its magnetic and contact parts, and wall_minus_virial (particle wall
@@ -45,7 +57,6 @@ class StressSeries {
   // The structure: extra["spanning_fraction"] (+ "_err"), the share of free
   // spheres in gap-spanning clusters, and extra["wall_cluster_fraction"].
   void finish(RunSummary& s) const;
-  std::size_t size() const { return total_.size(); }
   Measurement fluid() const;
   // Checkpoints: one field list for both directions, Self = StressSeries or
   // const StressSeries (Archive::io puts or gets each field).
@@ -59,7 +70,7 @@ class StressSeries {
 
  private:
   std::vector<double> total_, particles_, fluid_, virial_, mag_, con_, diff_, vir_fluid_, vir_total_;
-  std::vector<double> spanning_, wall_clusters_;  // ClusterStats of each row's end
+  std::vector<double> spanning_, wall_clusters_;  // ClusterStats of the rows that sampled it
 };
 
 // The fields of summary.json that come from the scene alone (model, Mn,
