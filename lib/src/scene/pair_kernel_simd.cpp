@@ -10,12 +10,13 @@
 // hertz_law_t) evaluated on whole vectors, a pair beyond the range masked
 // out, and the partners' forces gathered, decremented and scattered back (a
 // row's partners are distinct, so lanes never collide). The Hertz law runs on
-// max(h, 0), which gives 0 without overlap, so there is no branch. The tail
-// of a row shorter than a vector runs the same laws on doubles. Each pair's
-// force is the scalar loop's to the last bit (the same operations in the
-// same order, no contraction); the row sums run in another order, so the
-// totals agree with free_rows to round-off
-// (verification/forces/test_pair_kernel_simd.cpp).
+// max(h, 0), which gives 0 without overlap, and only on vectors with a
+// contact in them. The tail of a row shorter than a vector runs the same laws
+// on doubles. The pair forces are the scalar loop's expressions except 1/r
+// (on AVX-512 a refined rsqrt14, a few ulp from 1/sqrt), and the row sums run
+// in another order, so forces and sums agree with free_rows to round-off
+// (PairLoop.VectorKernelEqualsTheScalarLoop in
+// verification/forces/test_pair_loop.cpp).
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "scene/pair_kernel_simd.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
@@ -65,6 +66,23 @@ inline void scalar_pair(const DipoleX& dipole, double k_hertz, double two_r, dou
   fk[0] -= gx, fk[1] -= gy, fk[2] -= gz;
 }
 
+// 1/sqrt(v). On AVX-512 the 14-bit estimate of rsqrt14 refined by two Newton
+// steps, y (3 - v y^2) / 2 (error 2^-56 before rounding, a few ulp after),
+// which costs less than a sqrt and a division; elsewhere 1/sqrt(v).
+template <class V>
+HWY_INLINE V inverse_sqrt(V v) {
+#if HWY_TARGET == HWY_AVX3
+  const hn::DFromV<V> d;
+  const auto half = hn::Set(d, 0.5), three = hn::Set(d, 3.0);
+  auto y = V{_mm512_rsqrt14_pd(v.raw)};
+  y = hn::Mul(hn::Mul(half, y), hn::NegMulAdd(hn::Mul(v, y), y, three));
+  y = hn::Mul(hn::Mul(half, y), hn::NegMulAdd(hn::Mul(v, y), y, three));
+  return y;
+#else
+  return hn::Div(hn::Set(hn::DFromV<V>(), 1.0), hn::Sqrt(v));
+#endif
+}
+
 void FreeRows(const DemPairLaws<>& laws, const Box& box, const std::vector<Vec3>& x, const PairRows& rows,
               std::size_t row_begin, std::size_t row_end, std::vector<Vec3>& f, PairSums& out) {
   using D = hn::ScalableTag<double>;
@@ -81,7 +99,6 @@ void FreeRows(const DemPairLaws<>& laws, const Box& box, const std::vector<Vec3>
   const auto vsqrt = [](hn::Vec<D> v) { return hn::Sqrt(v); };
   const auto pref = hn::Set(d, dipole.pref), vk = hn::Set(d, k_hertz), vtwo_r = hn::Set(d, two_r);
   const auto vrange2 = hn::Set(d, range2), vcontact2 = hn::Set(d, two_r * two_r), zero = hn::Zero(d);
-  const auto one = hn::Set(d, 1.0);
   const auto ly = hn::Set(d, mi.ly), inv_ly = hn::Set(d, mi.inv_ly), lz = hn::Set(d, mi.lz), inv_lz = hn::Set(d, mi.inv_lz);
   const auto magic = hn::Set(d, 6755399441055744.0);  // MinImageYZ::round_nearest
   const std::uint32_t* ks = rows.k.data();
@@ -106,7 +123,7 @@ void FreeRows(const DemPairLaws<>& laws, const Box& box, const std::vector<Vec3>
       dz = hn::Sub(dz, hn::Mul(lz, hn::Sub(hn::Add(hn::Mul(dz, inv_lz), magic), magic)));
       const auto r2 = hn::Add(hn::Add(hn::Mul(dx, dx), hn::Mul(dy, dy)), hn::Mul(dz, dz));
       const auto in_range = hn::Lt(r2, vrange2);
-      const auto inv_r = hn::Div(one, hn::Sqrt(r2));
+      const auto inv_r = inverse_sqrt(r2);
       hn::Vec<D> gx, gy, gz;
       const auto ed = dipole_x_law(pref, dx, dy, dz, inv_r, gx, gy, gz, num);
       e_dip = hn::Add(e_dip, hn::IfThenElseZero(in_range, ed));
