@@ -1,8 +1,11 @@
 // Pair forces of the DEM scene (dipole + Hertz between free particles, Hertz
 // between free and wall spheres) and the sums the stress observables need.
 // The laws are the evaluators of forces/ (DipoleX, HertzPair); this file is
-// the one loop around them (STYLE.md §1, §4): minimum image, cut-off, +-F,
-// virial and sums. OpenMP over the half pair lists with one force buffer per
+// the loop around them (STYLE.md §1, §4): minimum image, cut-off, +-F,
+// virial and sums. The scene's own laws run its free-free rows on the
+// vector units (free_rows_simd, scene/pair_kernel_simd.cpp, the same law
+// templates of forces/laws-inl.h); other evaluators (tests, the
+// quasi-static driver's shifted-force dipole) run the scalar free_rows. OpenMP over the half pair lists with one force buffer per
 // thread, reduced in thread order: bitwise reproducible for a fixed thread
 // count.
 #pragma once
