@@ -25,6 +25,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "mrf/quasistatic/shifted_dipole.hpp"
 #include "mrf/scene/dem_forces.hpp"
 
 HWY_BEFORE_NAMESPACE();
@@ -39,7 +40,8 @@ struct KernelSums {
 };
 
 // One pair on doubles (the tail of a row): the scalar loop of free_rows.
-inline void scalar_pair(const DipoleX& dipole, double k_hertz, double two_r, double range2, const MinImageYZ& mi,
+template <class Dipole>
+inline void scalar_pair(const Dipole& dipole, double k_hertz, double two_r, double range2, const MinImageYZ& mi,
                         double xi, double yi, double zi, const double* xk, double* fk, double& fx, double& fy,
                         double& fz, KernelSums& s) {
   const double dx = xi - xk[0];
@@ -49,8 +51,9 @@ inline void scalar_pair(const DipoleX& dipole, double k_hertz, double two_r, dou
   if (r2 >= range2) return;
   const auto num = [](double v) { return v; };
   const double inv_r = 1.0 / std::sqrt(r2);
-  double gx, gy, gz;
-  s.e_dip += dipole_x_law(dipole.pref, dx, dy, dz, inv_r, gx, gy, gz, num);
+  Vec3 g;
+  s.e_dip += dipole.eval(dx, dy, dz, inv_r, g);
+  double gx = g.x(), gy = g.y(), gz = g.z();
   s.vir_mag += dx * gz;
   const double h = two_r - r2 * inv_r;
   if (h > 0) {
@@ -83,21 +86,50 @@ HWY_INLINE V inverse_sqrt(V v) {
 #endif
 }
 
-void FreeRows(const DemPairLaws<>& laws, const Box& box, const std::vector<Vec3>& x, const PairRows& rows,
-              std::size_t row_begin, std::size_t row_end, std::vector<Vec3>& f, PairSums& out) {
-  using D = hn::ScalableTag<double>;
+using D = hn::ScalableTag<double>;
+using V = hn::Vec<D>;
+
+// The vector form of each dipole evaluator the kernel serves: its
+// parameters broadcast once, and the law of laws-inl.h on whole vectors.
+template <class Dipole>
+struct VectorDipole;
+template <>
+struct VectorDipole<DipoleX> {
+  V pref;
+  VectorDipole(D d, const DipoleX& law) : pref(hn::Set(d, law.pref)) {}
+  template <class Num>
+  V eval(V dx, V dy, V dz, V /*r2*/, V inv_r, V& fx, V& fy, V& fz, Num num) const {
+    return dipole_x_law(pref, dx, dy, dz, inv_r, fx, fy, fz, num);
+  }
+};
+template <>
+struct VectorDipole<DipoleXShiftedForce> {  // the quasi-static driver's law
+  V pref, cutoff, inv_rc;
+  VectorDipole(D d, const DipoleXShiftedForce& law)
+      : pref(hn::Set(d, law.pref)), cutoff(hn::Set(d, law.cutoff)), inv_rc(hn::Set(d, law.inv_rc)) {}
+  template <class Num>
+  V eval(V dx, V dy, V dz, V r2, V inv_r, V& fx, V& fy, V& fz, Num num) const {
+    return dipole_x_shifted_law(pref, cutoff, inv_rc, dx, dy, dz, inv_r, hn::Mul(r2, inv_r), fx, fy, fz, num);
+  }
+};
+
+template <class Dipole>
+void FreeRowsOf(const DemPairLaws<Dipole, HertzPair>& laws, const Box& box, const std::vector<Vec3>& x,
+                const PairRows& rows, std::size_t row_begin, std::size_t row_end, std::vector<Vec3>& f,
+                PairSums& out) {
   const D d;
   const hn::RebindToSigned<D> di;                 // int64 lanes: the gather indices
   const hn::Rebind<std::uint32_t, D> du;          // the list's uint32 partner indices
   const hn::RebindToUnsigned<D> du64;
   const std::size_t lanes = hn::Lanes(d);
-  const DipoleX dipole = laws.dipole;
+  const Dipole dipole = laws.dipole;
+  const VectorDipole<Dipole> vdipole(d, dipole);
   const double k_hertz = laws.contact.k, two_r = laws.contact.sum_radii;
   const double range2 = std::max(laws.dipole_cutoff * laws.dipole_cutoff, two_r * two_r);
   const MinImageYZ mi(box);
   const auto num = [&d](double v) { return hn::Set(d, v); };
-  const auto vsqrt = [](hn::Vec<D> v) { return hn::Sqrt(v); };
-  const auto pref = hn::Set(d, dipole.pref), vk = hn::Set(d, k_hertz), vtwo_r = hn::Set(d, two_r);
+  const auto vsqrt = [](V v) { return hn::Sqrt(v); };
+  const auto vk = hn::Set(d, k_hertz), vtwo_r = hn::Set(d, two_r);
   const auto vrange2 = hn::Set(d, range2), vcontact2 = hn::Set(d, two_r * two_r), zero = hn::Zero(d);
   const auto ly = hn::Set(d, mi.ly), inv_ly = hn::Set(d, mi.inv_ly), lz = hn::Set(d, mi.lz), inv_lz = hn::Set(d, mi.inv_lz);
   const auto magic = hn::Set(d, 6755399441055744.0);  // MinImageYZ::round_nearest
@@ -124,13 +156,13 @@ void FreeRows(const DemPairLaws<>& laws, const Box& box, const std::vector<Vec3>
       const auto r2 = hn::Add(hn::Add(hn::Mul(dx, dx), hn::Mul(dy, dy)), hn::Mul(dz, dz));
       const auto in_range = hn::Lt(r2, vrange2);
       const auto inv_r = inverse_sqrt(r2);
-      hn::Vec<D> gx, gy, gz;
-      const auto ed = dipole_x_law(pref, dx, dy, dz, inv_r, gx, gy, gz, num);
+      V gx, gy, gz;
+      const auto ed = vdipole.eval(dx, dy, dz, r2, inv_r, gx, gy, gz, num);
       e_dip = hn::Add(e_dip, hn::IfThenElseZero(in_range, ed));
       vir_mag = hn::Add(vir_mag, hn::IfThenElseZero(in_range, hn::Mul(dx, gz)));
       if (!hn::AllFalse(d, hn::Lt(r2, vcontact2))) {  // contacts are rare: most vectors skip the Hertz law
         const auto h = hn::Max(hn::Sub(vtwo_r, hn::Mul(r2, inv_r)), zero);
-        hn::Vec<D> force, energy;
+        V force, energy;
         hertz_law_t(h, vk, force, energy, num, vsqrt);
         const auto f_over_r = hn::Mul(force, inv_r);
         vir_con = hn::Add(vir_con, hn::Mul(dx, hn::Mul(f_over_r, dz)));
@@ -163,6 +195,16 @@ void FreeRows(const DemPairLaws<>& laws, const Box& box, const std::vector<Vec3>
   out.max_overlap = std::max(s.max_h, hn::GetLane(hn::MaxOfLanes(d, max_h)));
 }
 
+void FreeRows(const DemPairLaws<>& laws, const Box& box, const std::vector<Vec3>& x, const PairRows& rows,
+              std::size_t row_begin, std::size_t row_end, std::vector<Vec3>& f, PairSums& out) {
+  FreeRowsOf(laws, box, x, rows, row_begin, row_end, f, out);
+}
+void FreeRowsShifted(const DemPairLaws<DipoleXShiftedForce, HertzPair>& laws, const Box& box,
+                     const std::vector<Vec3>& x, const PairRows& rows, std::size_t row_begin, std::size_t row_end,
+                     std::vector<Vec3>& f, PairSums& out) {
+  FreeRowsOf(laws, box, x, rows, row_begin, row_end, f, out);
+}
+
 const char* TargetName() { return hwy::TargetName(HWY_TARGET); }
 
 }  // namespace HWY_NAMESPACE
@@ -172,12 +214,18 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 namespace mrf {
 HWY_EXPORT(FreeRows);
+HWY_EXPORT(FreeRowsShifted);
 HWY_EXPORT(TargetName);
 
 namespace detail {
 void free_rows_simd(const DemPairLaws<>& laws, const Box& box, const std::vector<Vec3>& x, const PairRows& rows,
                     std::size_t row_begin, std::size_t row_end, std::vector<Vec3>& f, PairSums& s) {
   HWY_DYNAMIC_DISPATCH(FreeRows)(laws, box, x, rows, row_begin, row_end, f, s);
+}
+void free_rows_simd_shifted(const DemPairLaws<DipoleXShiftedForce, HertzPair>& laws, const Box& box,
+                            const std::vector<Vec3>& x, const PairRows& rows, std::size_t row_begin,
+                            std::size_t row_end, std::vector<Vec3>& f, PairSums& s) {
+  HWY_DYNAMIC_DISPATCH(FreeRowsShifted)(laws, box, x, rows, row_begin, row_end, f, s);
 }
 }  // namespace detail
 

@@ -32,3 +32,24 @@ inline void hertz_law_t(T overlap, T k, T& force, T& energy, Num num, Sqrt sqrt_
   force = k * overlap * sh;
   energy = num(0.4) * k * overlap * overlap * sh;
 }
+
+// The shifted-force form of the same law for energy minimisation
+// (quasistatic/shifted_dipole.hpp, where it is derived): the radial factor
+// r^-3 becomes phi_sf = r^-3 - r_c^-3 + 3 (r - r_c) r_c^-4, so energy and
+// force vanish continuously at r_c. For r < r_c only (the caller cuts);
+// r = 1/inv_r, inv_rc = 1/r_c. Returns (1 - 3c^2) phi_sf (1/m^3).
+template <class T, class Num>
+inline T dipole_x_shifted_law(T pref, T cutoff, T inv_rc, T dx, T dy, T dz, T inv_r, T r, T& fx, T& fy, T& fz,
+                              Num num) {
+  const T inv_r2 = inv_r * inv_r, inv_r4 = inv_r2 * inv_r2;
+  const T inv_rc3 = inv_rc * inv_rc * inv_rc, inv_rc4 = inv_rc3 * inv_rc;
+  const T c = dx * inv_r, c2 = c * c;
+  const T phi = inv_r2 * inv_r - inv_rc3 + num(3.0) * (r - cutoff) * inv_rc4;
+  const T radial = pref * ((num(1.0) - num(3.0) * c2) * (inv_r4 - inv_rc4) - num(2.0) * c2 * phi * inv_r);
+  const T a = radial * inv_r;                      // radial part / r, multiplies r_ik
+  const T b = num(2.0) * pref * c * phi * inv_r;   // along x^
+  fx = a * dx + b;
+  fy = a * dy;
+  fz = a * dz;
+  return (num(1.0) - num(3.0) * c2) * phi;
+}

@@ -17,12 +17,14 @@
 #pragma once
 #include <cmath>
 
+#include "mrf/forces/generic_laws.hpp"
 #include "mrf/vec.hpp"
 
 namespace mrf {
 
 // Pair evaluator with the interface of DipoleX (forces/dipole.hpp), so the
-// one pair loop of scene/dem_forces.hpp runs it unchanged.
+// pair loops of scene/dem_forces.hpp run it unchanged; its law is
+// dipole_x_shifted_law of forces/laws-inl.h, which the vector kernel runs too.
 struct DipoleXShiftedForce {
   double pref;    // 3 mu0 m^2 / (4 pi) (N m^4)
   double cutoff;  // r_c (m)
@@ -37,15 +39,8 @@ struct DipoleXShiftedForce {
       f = Vec3::Zero();
       return 0.0;
     }
-    const double inv_r2 = inv_r * inv_r, inv_r4 = inv_r2 * inv_r2;
-    const double inv_rc3 = inv_rc * inv_rc * inv_rc, inv_rc4 = inv_rc3 * inv_rc;
-    const double c = dx * inv_r, c2 = c * c;
-    const double phi = inv_r2 * inv_r - inv_rc3 + 3.0 * (r - cutoff) * inv_rc4;
-    const double radial = pref * ((1.0 - 3.0 * c2) * (inv_r4 - inv_rc4) - 2.0 * c2 * phi * inv_r);
-    const double a = radial * inv_r;               // radial part / r, multiplies r_ik
-    const double b = 2.0 * pref * c * phi * inv_r;  // along x^
-    f = Vec3(a * dx + b, a * dy, a * dz);
-    return (1.0 - 3.0 * c2) * phi;
+    return dipole_x_shifted_law(pref, cutoff, inv_rc, dx, dy, dz, inv_r, r, f.x(), f.y(), f.z(),
+                                [](double v) { return v; });
   }
   // J m^3: turns a sum of eval() returns into an energy.
   double energy_scale() const { return pref / 3.0; }

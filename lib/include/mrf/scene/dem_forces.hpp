@@ -4,8 +4,8 @@
 // the loop around them (STYLE.md §1, §4): minimum image, cut-off, +-F,
 // virial and sums. The scene's own laws run its free-free rows on the
 // vector units (free_rows_simd, scene/pair_kernel_simd.cpp, the same law
-// templates of forces/laws-inl.h); other evaluators (tests, the
-// quasi-static driver's shifted-force dipole) run the scalar free_rows. OpenMP over the half pair lists with one force buffer per
+// templates of forces/laws-inl.h), and so do the quasi-static driver's
+// (shifted-force dipole); other evaluators (tests) run the scalar free_rows. OpenMP over the half pair lists with one force buffer per
 // thread, reduced in thread order: bitwise reproducible for a fixed thread
 // count.
 #pragma once
@@ -25,6 +25,8 @@
 #include "mrf/state.hpp"
 
 namespace mrf {
+
+struct DipoleXShiftedForce;  // quasistatic/shifted_dipole.hpp
 
 struct PairSums {
   std::array<double, 2> wall_fz{0, 0};  // z-force of the particles on the lower [0] / upper [1] wall (N)
@@ -174,10 +176,14 @@ void wall_pairs(const DemPairLaws<Dipole, Contact>& laws, const Box& box, const 
   }
 }
 
-// free_rows<true, false> of the scene's laws on the vector units, the best
-// instruction set of the machine chosen at run time (pair_kernel_simd.cpp).
+// free_rows<true, false> on the vector units, the best instruction set of
+// the machine chosen at run time (pair_kernel_simd.cpp): the scene's laws,
+// and the quasi-static driver's (shifted-force dipole + Hertz).
 void free_rows_simd(const DemPairLaws<>& laws, const Box& box, const std::vector<Vec3>& x, const PairRows& rows,
                     std::size_t row_begin, std::size_t row_end, std::vector<Vec3>& f, PairSums& s);
+void free_rows_simd_shifted(const DemPairLaws<DipoleXShiftedForce, HertzPair>& laws, const Box& box,
+                            const std::vector<Vec3>& x, const PairRows& rows, std::size_t row_begin,
+                            std::size_t row_end, std::vector<Vec3>& f, PairSums& s);
 
 template <class Dipole, class Contact>
 void pair_share(const DemPairLaws<Dipole, Contact>& laws, const Box& box, const FreeParticles& free,
@@ -189,6 +195,8 @@ void pair_share(const DemPairLaws<Dipole, Contact>& laws, const Box& box, const 
   else if (laws.dipole_cutoff >= laws.contact.sum_radii) {
     if constexpr (std::is_same_v<Dipole, DipoleX> && std::is_same_v<Contact, HertzPair>)
       free_rows_simd(laws, box, free.x, lists.ff, r0, r1, f, s);
+    else if constexpr (std::is_same_v<Dipole, DipoleXShiftedForce> && std::is_same_v<Contact, HertzPair>)
+      free_rows_simd_shifted(laws, box, free.x, lists.ff, r0, r1, f, s);
     else
       free_rows<true, false>(laws, box, free.x, lists.ff, r0, r1, f, s);
   }
