@@ -1,5 +1,6 @@
-// The free-free rows of the scene's pair laws (DipoleX + HertzPair, every
-// pair in range inside the dipole cut-off) on the vector units, with Google
+// The free-free rows of the pair laws (DipoleX or the quasi-static driver's
+// DipoleXShiftedForce, with HertzPair; every pair in range inside the dipole
+// cut-off) on the vector units, with Google
 // Highway: compiled for every instruction set Highway targets on this
 // architecture (AVX-512, AVX2 + FMA, SSE4, ...), the best one the machine
 // has chosen at the first call (HWY_DYNAMIC_DISPATCH), so one binary runs at
