@@ -138,13 +138,14 @@ SphPairs sorted_candidates(const FluidCell& cell, double skin) {
 bool cache_stale(const FluidCell& cell, const SphPairCache& cache) {
   if (cache.x_fluid.size() != cell.fluid.size() || cache.x_wall.size() != cell.wall.size()) return true;
   const Box& box = cell.box;
-  const double reach = k_kernel_support * cell.h + cache.skin, flow = std::abs(cache.strain) * reach;
+  const double reach = k_kernel_support * cell.h + cache.skin;
   const double df = max_nonaffine_displacement(cell.fluid.x, cache.x_fluid, box, cache.strain);
   const double dw = max_nonaffine_displacement(cell.wall.x, cache.x_wall, box, cache.strain);
   // The separations are continued by minimum-image displacements: keep them
   // far below half the box.
   const double quarter = 0.25 * std::min(box.ly, box.lz);
-  return 2.0 * df + flow > cache.skin || df + dw + flow > cache.skin ||
+  return skin_spent(2.0 * df, cache.strain, reach, cache.skin) ||
+         skin_spent(df + dw, cache.strain, reach, cache.skin) ||
          max_displacement(cell.fluid.x, cache.x_fluid, box) > quarter ||
          max_displacement(cell.wall.x, cache.x_wall, box) > quarter;
 }

@@ -40,8 +40,8 @@ const std::vector<Vec3>& ImplicitStepper::begin_step(const DemPairLists& lists, 
   const double r = p_.radius, margin = k_contact_margin_over_radius * r;
   const double near_skin = near_reach_ - (2.0 * r + margin);
   if (near_x_.size() != f.size() ||
-      2.0 * max_nonaffine_displacement(f.x, near_x_, box, near_strain_) + std::abs(near_strain_) * near_reach_ >
-          near_skin) {
+      skin_spent(2.0 * max_nonaffine_displacement(f.x, near_x_, box, near_strain_), near_strain_, near_reach_,
+                 near_skin)) {
     near_pairs(lists.ff, f.x, box, near_reach_, near_ff_);
     near_x_ = f.x;
     near_strain_ = 0;

@@ -57,15 +57,14 @@ FreeFreeMotion ff_motion(const DemPairLists& l, const FreeParticles& free, const
 }
 
 bool ff_stale(const DemPairLists& l, const FreeFreeMotion& m) {
-  return m.unbuilt || 2.0 * m.nonaffine + std::abs(l.strain_ff) * (l.ff_range + l.skin) > l.skin;
+  return m.unbuilt || skin_spent(2.0 * m.nonaffine, l.strain_ff, l.ff_range + l.skin, l.skin);
 }
 
 bool fw_stale(const DemPairLists& l, const FreeParticles& free, std::size_t n_walls, const Box& box) {
   if (l.fw_range <= 0) return false;
   if (l.builds == 0 || l.x_ref_fw.size() != free.size() || l.walls_ref != n_walls) return true;
-  return max_nonaffine_displacement(free.x, l.x_ref_fw, box, l.strain_fw) +
-             std::abs(l.strain_fw) * (l.fw_range + l.skin) >
-         l.skin;
+  return skin_spent(max_nonaffine_displacement(free.x, l.x_ref_fw, box, l.strain_fw), l.strain_fw,
+                    l.fw_range + l.skin, l.skin);
 }
 
 // An adaptive skin is chosen from the rates since the last free-free

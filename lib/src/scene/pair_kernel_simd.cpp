@@ -12,8 +12,8 @@
 // out, and the partners' forces gathered, decremented and scattered back (a
 // row's partners are distinct, so lanes never collide). The Hertz law runs on
 // max(h, 0), which gives 0 without overlap, and only on vectors with a
-// contact in them. The tail of a row shorter than a vector runs the same laws
-// on doubles. The pair forces are the scalar loop's expressions except 1/r
+// contact in them. The tail of a row shorter than a vector runs the scalar
+// loop's pair (detail::pair_force). The pair forces are the scalar loop's expressions except 1/r
 // (on AVX-512 a refined rsqrt14, a few ulp from 1/sqrt), and the row sums run
 // in another order, so forces and sums agree with free_rows to round-off
 // (PairLoop.VectorKernelEqualsTheScalarLoop in
@@ -34,41 +34,6 @@ namespace mrf {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 #include "mrf/forces/laws-inl.h"  // the laws, compiled for this target
-
-// Sums of a row or of a share of rows.
-struct KernelSums {
-  double vir_mag = 0, e_dip = 0, vir_con = 0, e_hertz = 0, max_h = 0;
-};
-
-// One pair on doubles (the tail of a row): the scalar loop of free_rows.
-template <class Dipole>
-inline void scalar_pair(const Dipole& dipole, double k_hertz, double two_r, double range2, const MinImageYZ& mi,
-                        double xi, double yi, double zi, const double* xk, double* fk, double& fx, double& fy,
-                        double& fz, KernelSums& s) {
-  const double dx = xi - xk[0];
-  const double dy = mi.wrap_y(yi - xk[1]);
-  const double dz = mi.wrap_z(zi - xk[2]);
-  const double r2 = dx * dx + dy * dy + dz * dz;
-  if (r2 >= range2) return;
-  const auto num = [](double v) { return v; };
-  const double inv_r = 1.0 / std::sqrt(r2);
-  Vec3 g;
-  s.e_dip += dipole.eval(dx, dy, dz, inv_r, g);
-  double gx = g.x(), gy = g.y(), gz = g.z();
-  s.vir_mag += dx * gz;
-  const double h = two_r - r2 * inv_r;
-  if (h > 0) {
-    double force, energy;
-    hertz_law_t(h, k_hertz, force, energy, num, [](double v) { return std::sqrt(v); });
-    const double f_over_r = force * inv_r;
-    s.vir_con += dx * (f_over_r * dz);
-    s.e_hertz += energy;
-    s.max_h = std::max(s.max_h, h);
-    gx += f_over_r * dx, gy += f_over_r * dy, gz += f_over_r * dz;
-  }
-  fx += gx, fy += gy, fz += gz;
-  fk[0] -= gx, fk[1] -= gy, fk[2] -= gz;
-}
 
 // 1/sqrt(v). On AVX-512 the 14-bit estimate of rsqrt14 refined by two Newton
 // steps, y (3 - v y^2) / 2 (error 2^-56 before rounding, a few ulp after),
@@ -126,18 +91,19 @@ void FreeRowsOf(const DemPairLaws<Dipole, HertzPair>& laws, const Box& box, cons
   const Dipole dipole = laws.dipole;
   const VectorDipole<Dipole> vdipole(d, dipole);
   const double k_hertz = laws.contact.k, two_r = laws.contact.sum_radii;
-  const double range2 = std::max(laws.dipole_cutoff * laws.dipole_cutoff, two_r * two_r);
+  const double rc2 = laws.dipole_cutoff * laws.dipole_cutoff, contact2 = two_r * two_r;
+  const double range2 = std::max(rc2, contact2);
   const MinImageYZ mi(box);
   const auto num = [&d](double v) { return hn::Set(d, v); };
   const auto vsqrt = [](V v) { return hn::Sqrt(v); };
   const auto vk = hn::Set(d, k_hertz), vtwo_r = hn::Set(d, two_r);
-  const auto vrange2 = hn::Set(d, range2), vcontact2 = hn::Set(d, two_r * two_r), zero = hn::Zero(d);
+  const auto vrange2 = hn::Set(d, range2), vcontact2 = hn::Set(d, contact2), zero = hn::Zero(d);
   const auto ly = hn::Set(d, mi.ly), inv_ly = hn::Set(d, mi.inv_ly), lz = hn::Set(d, mi.lz), inv_lz = hn::Set(d, mi.inv_lz);
   const auto magic = hn::Set(d, 6755399441055744.0);  // MinImageYZ::round_nearest
   const std::uint32_t* ks = rows.k.data();
   const double* xs = x.data()->data();  // Vec3: three packed doubles
   double* fs = f.data()->data();
-  KernelSums s;
+  detail::PairTally s;
   s.max_h = out.max_overlap;
   auto vir_mag = zero, e_dip = zero, vir_con = zero, e_hertz = zero, max_h = zero;
   for (std::size_t i = row_begin; i < row_end; ++i) {
@@ -183,9 +149,14 @@ void FreeRowsOf(const DemPairLaws<Dipole, HertzPair>& laws, const Box& box, cons
     }
     double sx = hn::GetLane(hn::SumOfLanes(d, fx)), sy = hn::GetLane(hn::SumOfLanes(d, fy)),
            sz = hn::GetLane(hn::SumOfLanes(d, fz));
-    for (; n < end; ++n) {
+    for (; n < end; ++n) {  // the tail: free_rows's pair on doubles
       const std::size_t k = 3 * static_cast<std::size_t>(ks[n]);
-      scalar_pair(dipole, k_hertz, two_r, range2, mi, xi, yi, zi, xs + k, fs + k, sx, sy, sz, s);
+      const double dx = xi - xs[k], dy = mi.wrap_y(yi - xs[k + 1]), dz = mi.wrap_z(zi - xs[k + 2]);
+      const double r2 = dx * dx + dy * dy + dz * dz;
+      if (r2 >= range2) continue;
+      const Vec3 g = detail::pair_force<true, false>(dipole, laws.contact, rc2, contact2, dx, dy, dz, r2, s);
+      sx += g.x(), sy += g.y(), sz += g.z();
+      fs[k] -= g.x(), fs[k + 1] -= g.y(), fs[k + 2] -= g.z();
     }
     fs[3 * i] += sx, fs[3 * i + 1] += sy, fs[3 * i + 2] += sz;
   }

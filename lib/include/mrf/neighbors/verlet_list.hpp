@@ -24,6 +24,7 @@
 // sweep of the same list (choose_skin). The rule depends only on the
 // trajectory, so runs stay reproducible and resume bit for bit.
 #pragma once
+#include <cmath>
 #include <vector>
 
 #include "mrf/neighbors/cell_list.hpp"
@@ -67,6 +68,16 @@ struct DemPairLists {
           s.builds, s.ff_builds);
   }
 };
+
+// The bound above for any Verlet list: a list of pairs within `reach`
+// (range + skin) at its build is spent when the pairs' largest non-affine
+// closing (2 max|n| within one set of points, max|n_a| + max|n_b| between
+// two) plus the imposed strain since the build times the reach exceeds the
+// skin (m). The DEM lists, the implicit scheme's near list and the SPH pair
+// cache all test this.
+inline bool skin_spent(double nonaffine_closing, double strain, double reach, double skin) {
+  return nonaffine_closing + std::abs(strain) * reach > skin;
+}
 
 // Largest displacement (m) of the points x from `ref` (minimum image).
 double max_displacement(const std::vector<Vec3>& x, const std::vector<Vec3>& ref, const Box& box);

@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <type_traits>
 #include <vector>
@@ -85,6 +86,40 @@ std::size_t chunk(std::size_t n, int t, int nt);
 // Threads worth starting for this many pairs (depends on the lists alone).
 int pair_threads(const DemPairLists& lists);
 
+// Sums of the pair terms of a share of rows (dipole energy without its
+// constant, see DipoleX::energy_scale).
+struct PairTally {
+  double vir_mag = 0, e_dip = 0, vir_con = 0, e_hertz = 0, max_h = 0;
+};
+
+// The force on i of one free-free pair in range, (dx, dy, dz) = r_ik with
+// r2 = |r_ik|^2, its virial and energy terms added to t: the scalar loop's
+// pair, which the vector kernel's row tails run too.
+template <bool Magnetic, bool DipoleTest, class Dipole, class Contact>
+inline Vec3 pair_force(const Dipole& dipole, const Contact& contact, double rc2, double contact2, double dx,
+                       double dy, double dz, double r2, PairTally& t) {
+  const double inv_r = 1.0 / std::sqrt(r2);
+  Vec3 fik = Vec3::Zero();
+  if constexpr (Magnetic) {
+    if (!DipoleTest || r2 < rc2) {
+      t.e_dip += dipole.eval(dx, dy, dz, inv_r, fik);
+      t.vir_mag += dx * fik.z();
+    }
+  }
+  // r2 < contact2 first: it is known before the sqrt, so the rare
+  // contact branch is resolved early (the evaluator's own h > 0 test
+  // waits for 1/r).
+  HertzContact c;
+  if (r2 < contact2 && contact.eval(r2, inv_r, c)) {
+    const Vec3 fc(c.f_over_r * dx, c.f_over_r * dy, c.f_over_r * dz);
+    t.vir_con += dx * fc.z();
+    t.e_hertz += c.energy;
+    t.max_h = std::max(t.max_h, c.overlap);
+    fik += fc;
+  }
+  return fik;
+}
+
 // Free-free rows [row_begin, row_end), forces into f. Row i keeps x[i] and
 // its force in registers; the minimum image is branch-free; one 1/sqrt(r^2)
 // serves both evaluators; the dipole energy is summed without its constant
@@ -107,7 +142,8 @@ void free_rows(const DemPairLaws<Dipole, Contact>& laws, const Box& box, const s
   const std::uint32_t* ks = rows.k.data();
   const Vec3* xs = x.data();
   Vec3* fs = f.data();
-  double vir_mag = 0, e_dip = 0, vir_con = 0, e_hertz = 0, max_h = s.max_overlap;
+  PairTally t;
+  t.max_h = s.max_overlap;
   for (std::size_t i = row_begin; i < row_end; ++i) {
     const Vec3 xi = xs[i];
     Vec3 fi = Vec3::Zero();
@@ -118,35 +154,17 @@ void free_rows(const DemPairLaws<Dipole, Contact>& laws, const Box& box, const s
       const double dz = mi.wrap_z(xi.z() - xs[k].z());
       const double r2 = dx * dx + dy * dy + dz * dz;
       if (r2 >= range2) continue;
-      const double inv_r = 1.0 / std::sqrt(r2);
-      Vec3 fik = Vec3::Zero();
-      if constexpr (Magnetic) {
-        if (!DipoleTest || r2 < rc2) {
-          e_dip += dipole.eval(dx, dy, dz, inv_r, fik);
-          vir_mag += dx * fik.z();
-        }
-      }
-      // r2 < contact2 first: it is known before the sqrt, so the rare
-      // contact branch is resolved early (the evaluator's own h > 0 test
-      // waits for 1/r).
-      HertzContact c;
-      if (r2 < contact2 && contact.eval(r2, inv_r, c)) {
-        const Vec3 fc(c.f_over_r * dx, c.f_over_r * dy, c.f_over_r * dz);
-        vir_con += dx * fc.z();
-        e_hertz += c.energy;
-        max_h = std::max(max_h, c.overlap);
-        fik += fc;
-      }
+      const Vec3 fik = pair_force<Magnetic, DipoleTest>(dipole, contact, rc2, contact2, dx, dy, dz, r2, t);
       fi += fik;
       fs[k] -= fik;
     }
     fs[i] += fi;
   }
-  s.virial_mag_xz += vir_mag;
-  if constexpr (Magnetic) s.energy_dipole += dipole.energy_scale() * e_dip;
-  s.virial_con_xz += vir_con;
-  s.energy_hertz += e_hertz;
-  s.max_overlap = max_h;
+  s.virial_mag_xz += t.vir_mag;
+  if constexpr (Magnetic) s.energy_dipole += dipole.energy_scale() * t.e_dip;
+  s.virial_con_xz += t.vir_con;
+  s.energy_hertz += t.e_hertz;
+  s.max_overlap = t.max_h;
 }
 
 // Free-wall pairs [begin, end); only the free sphere's force is kept, the

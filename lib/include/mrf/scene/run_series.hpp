@@ -32,7 +32,6 @@ struct SeriesRow {
   void add(const PairSums& p, const Box& box, double fluid_stress, double fluid_virial, double w = 1.0);
 };
 
-// Row means after the warm-up, block-averaged at the end (observe/block_average).
 // The structure (cluster statistics, the cost of a cell-list pass) is
 // sampled at most once per this much strain: finer rows (a short benchmark
 // run writes one per step) would spend more on it than on the dynamics, and
@@ -42,6 +41,7 @@ inline constexpr double k_structure_sample_strain = 1e-3;
 // Rows between two structure samples for rows of `row_strain` each.
 long structure_stride(double row_strain);
 
+// Row means after the warm-up, block-averaged at the end (observe/block_average).
 class StressSeries {
  public:
   // with_structure: row.clusters was measured (see structure_stride).
