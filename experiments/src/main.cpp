@@ -2,7 +2,7 @@
 //   mrf run SCENE.toml [--set section.key=value]... [--out DIR] [--quiet] [--resume] [--checkpoint-every S]
 //   mrf criterion SWEEP_DIR|RUN_DIR [--thresholds FILE]
 //   mrf quasistatic SCENE.toml [--set k=v]... [--out DIR] [--increment D] [--tol T] [--strain S] [--warmup W]
-//             [--cutoff R] [--no-affine]
+//             [--cutoff R] [--no-affine] [--resume] [--checkpoint-every S]
 //   mrf sweep SWEEP.toml [--out DIR] [--quiet] [--estimate | --list | --collect] [--point K | --rank R --ranks K]
 //             [--checkpoint-every S] [--archive DIR]   (mpirun -n K: master-worker schedule)
 // Exit status: 0 done, 2 bad input, 3 numerical failure or refused
@@ -204,7 +204,8 @@ int main(int argc, char** argv) {
   std::string qs_scene, qs_out;
   std::vector<std::string> qs_sets;
   mrf::QuasistaticOptions qo;
-  bool qs_quiet = false, no_affine = false;
+  QuasistaticCliOptions qs_cli;
+  bool no_affine = false;
   double qs_strain = 0, qs_warmup = -1;
   qs->add_option("scene", qs_scene, "scene file (TOML)")->required();
   qs->add_option("--set", qs_sets, "override one key: section.key=value (repeatable)");
@@ -216,7 +217,12 @@ int main(int argc, char** argv) {
   qs->add_option("--cutoff", qo.dipole_cutoff, "shifted-force dipole cut-off in m (default particles.dipole_cutoff)");
   qs->add_option("--max-iterations", qo.max_iterations, "FIRE iterations per minimisation")->capture_default_str();
   qs->add_flag("--no-affine", no_affine, "free particles not displaced affinely before each minimisation");
-  qs->add_flag("--quiet", qs_quiet, "no progress on stderr");
+  qs->add_flag("--quiet", qs_cli.quiet, "no progress on stderr");
+  qs->add_flag("--resume", qs_cli.resume,
+               "continue from OUT/checkpoint.bin (same scene and options; a larger --strain extends a finished run)");
+  qs->add_option("--checkpoint-every", qs_cli.checkpoint_seconds,
+                 "wall seconds between checkpoints and partial CSVs (0 = only at the end)")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   try {
     if (*run) return run_command(scene, sets, out, quiet, resume, checkpoint_seconds);
@@ -227,7 +233,7 @@ int main(int argc, char** argv) {
       qo.affine = !no_affine;
       if (qs_strain > 0) qo.strain = qs_strain;
       if (qs_warmup >= 0) qo.warmup_strain = qs_warmup;
-      return quasistatic_command(qs_scene, qs_sets, qs_out, qo, qs_quiet);
+      return quasistatic_command(qs_scene, qs_sets, qs_out, qo, qs_cli);
     }
   } catch (const mrf::InputError& e) {
     std::fprintf(stderr, "mrf: error: %s\n", e.what());

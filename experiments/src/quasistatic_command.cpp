@@ -4,6 +4,13 @@
 // stress with their block-average errors, in Pa and in phi mu0 M^2, and the
 // options that produced them). The scene's shear rate and Mason number play
 // no part: the limit is rate-independent.
+//
+// A run of the paper cell takes hours: every --checkpoint-every wall seconds
+// (and at the end) OUT/checkpoint.bin and the CSV of the minima so far are
+// written; --resume continues from the checkpoint, bit for bit, and with a
+// larger --strain extends a finished run. The checkpoint names its scene
+// (scene_id) and options; another scene or increment, tolerance, affine
+// start or cut-off is refused.
 #include "quasistatic_command.hpp"
 
 #include <cstdio>
@@ -11,27 +18,16 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "mrf/error.hpp"
+#include "mrf/io/archive.hpp"
 #include "mrf/io/atomic_file.hpp"
 #include "mrf/io/toml_scene.hpp"
 #include "mrf/scene/run_series.hpp"
 #include "mrf/version.hpp"
 
-int quasistatic_command(const std::string& scene_path, const std::vector<std::string>& sets, std::string out,
-                        const mrf::QuasistaticOptions& opt, bool quiet) {
-  const mrf::LoadedScene scene = mrf::load_scene(scene_path, sets);
-  if (out.empty()) out = "out/" + std::filesystem::path(scene_path).stem().string() + "_quasistatic";
-  opt.validate();
-  const double strain = opt.strain.value_or(scene.config.strain);
-  if (!quiet)
-    std::fprintf(stderr, "mrf quasistatic: %s, increments of %g to strain %g, max |f| < %g F0, affine %s\n",
-                 scene_path.c_str(), opt.strain_increment, strain, opt.force_tol, opt.affine ? "on" : "off");
-  const auto observer = [&](const mrf::QuasistaticPoint& p) {
-    if (!quiet && p.increment % 10 == 0)
-      std::fprintf(stderr, "\r  strain %.4f / %g  wall %.4g Pa  virial %.4g Pa  %ld FIRE iterations   ", p.strain,
-                   strain, p.stress_wall, p.stress_virial, p.iterations);
-  };
-  const mrf::QuasistaticResult r = mrf::run_quasistatic(scene, opt, observer);
-  if (!quiet) std::fprintf(stderr, "\n");
+namespace {
+
+std::string csv_text(const mrf::QuasistaticResult& r) {
   std::ostringstream csv;
   csv.precision(10);
   csv << "strain,stress_wall,stress_virial,stress_virial_magnetic,stress_virial_contact,energy,max_force,"
@@ -40,8 +36,68 @@ int quasistatic_command(const std::string& scene_path, const std::vector<std::st
     csv << r.strain[k] << "," << r.stress_wall[k] << "," << r.stress_virial[k] << "," << r.stress_virial_magnetic[k]
         << "," << r.stress_virial_contact[k] << "," << r.energy[k] << "," << r.max_force[k] << "," << r.max_overlap[k]
         << "," << r.iterations[k] << "\n";
+  return csv.str();
+}
+
+void write_checkpoint(const mrf::QuasistaticRun& run, const std::string& id, const std::string& out) {
+  mrf::ArchiveWriter w(out + "/checkpoint.bin");
+  w.put(id);
+  run.save(w);
+  w.close();
+  mrf::write_file_atomic(out + "/quasistatic.csv", csv_text(run.series()));
+}
+
+}  // namespace
+
+int quasistatic_command(const std::string& scene_path, const std::vector<std::string>& sets, std::string out,
+                        const mrf::QuasistaticOptions& options, const QuasistaticCliOptions& cli) {
+  const mrf::LoadedScene scene = mrf::load_scene(scene_path, sets);
+  if (out.empty()) out = "out/" + std::filesystem::path(scene_path).stem().string() + "_quasistatic";
+  if (!(cli.checkpoint_seconds >= 0))
+    throw mrf::InputError("--checkpoint-every", std::to_string(cli.checkpoint_seconds), "", "must be >= 0 (0 = none)");
+  mrf::QuasistaticRun run = mrf::quasistatic_run(scene, options);
+  const mrf::QuasistaticOptions& opt = run.options();
+  const bool quiet = cli.quiet;
+  const std::string id = mrf::scene_id(scene.config), ckpt = out + "/checkpoint.bin";
   std::filesystem::create_directories(out);
-  mrf::write_file_atomic(out + "/quasistatic.csv", csv.str());
+  if (cli.resume && std::filesystem::exists(ckpt)) {
+    mrf::ArchiveReader in(ckpt);
+    std::string saved;
+    in.get(saved);
+    if (saved != id)
+      throw mrf::NumericalError("checkpoint " + ckpt + " is of scene " + saved + ", this scene (with its --set) is " + id +
+                                ": resume with the same scene and overrides, or start a new run (another --out)");
+    run.load(in);
+    in.expect_end();
+    if (!quiet)
+      std::fprintf(stderr, "mrf quasistatic: resumed from %s at increment %zu of %zu (%.0f s spent)\n", ckpt.c_str(),
+                   run.next_increment(), run.increments(), run.wall_seconds());
+  } else if (!cli.resume && std::filesystem::exists(ckpt)) {
+    throw mrf::InputError("--out", out, "", "holds a checkpoint of an earlier run: --resume continues it, or choose another --out");
+  }
+  if (!quiet)
+    std::fprintf(stderr, "mrf quasistatic: %s, increments of %g to strain %g, max |f| < %g F0, affine %s\n",
+                 scene_path.c_str(), opt.strain_increment, *opt.strain, opt.force_tol, opt.affine ? "on" : "off");
+  const std::size_t first = run.next_increment();
+  const double t_first = run.wall_seconds();
+  double t_saved = t_first;
+  while (!run.done()) {
+    const mrf::QuasistaticPoint p = run.step();
+    const double t = run.wall_seconds();
+    if (!quiet) {
+      const double per = (t - t_first) / static_cast<double>(run.next_increment() - first);
+      std::fprintf(stderr, "\r  strain %.4f / %g  wall %.4g Pa  virial %.4g Pa  %ld FIRE iterations  %.0f s, about %.0f s left   ",
+                   p.strain, *opt.strain, p.stress_wall, p.stress_virial, p.iterations, t,
+                   per * static_cast<double>(run.increments() + 1 - run.next_increment()));
+    }
+    if (cli.checkpoint_seconds > 0 && t - t_saved >= cli.checkpoint_seconds && !run.done()) {
+      write_checkpoint(run, id, out);
+      t_saved = t;
+    }
+  }
+  if (!quiet) std::fprintf(stderr, "\n");
+  write_checkpoint(run, id, out);  // kept: --resume with a larger --strain extends the run
+  const mrf::QuasistaticResult r = run.finish();
   nlohmann::ordered_json j;
   j["driver"] = "quasistatic (AQS, FIRE 2.0)";
   j["scene_id"] = mrf::scene_id(scene.config);

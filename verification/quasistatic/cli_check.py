@@ -3,7 +3,11 @@
 increments of 1e-3): exit 0, quasistatic.csv with one row per minimum (the
 initial one and five more), every minimum below the force tolerance, wall and
 virial stress equal within the static-equilibrium bound, and summary.json
-with the steady mean, its error and the scene's id.
+with the steady mean, its error and the scene's id. Then the checkpoint:
+the same --out without --resume is refused (exit 2); --resume with
+--strain 0.007 extends the finished run by two minima and leaves the first
+six rows as they were; --resume with another increment is refused (exit 3,
+naming quasistatic.strain_increment).
 
 Usage: cli_check.py MRF_BINARY SCENE WORKDIR
 """
@@ -11,8 +15,9 @@ import csv, json, pathlib, shutil, subprocess, sys
 
 mrf, scene, work = sys.argv[1], sys.argv[2], pathlib.Path(sys.argv[3])
 shutil.rmtree(work, ignore_errors=True)
-subprocess.run([mrf, "quasistatic", scene, "--set", "contact.youngs_modulus=2e9", "--strain", "0.005", "--warmup",
-                "0.002", "--increment", "1e-3", "--out", str(work), "--quiet"], check=True)
+base = [mrf, "quasistatic", scene, "--set", "contact.youngs_modulus=2e9", "--warmup", "0.002", "--out", str(work),
+        "--quiet"]
+subprocess.run(base + ["--strain", "0.005", "--increment", "1e-3"], check=True)
 s = json.loads((work / "summary.json").read_text())
 rows = list(csv.DictReader((work / "quasistatic.csv").open()))
 bad = []
@@ -33,5 +38,19 @@ for k in ("stress_wall", "stress_wall_err", "stress_virial", "scene_id", "stress
 # 5 increments of 1e-3 are far shorter than two periods lz/gap = 0.4: no orbit is claimed.
 if s.get("orbit_periodic") is not False or abs(s.get("orbit_period_strain", 0) - 32.0 / 80.0) > 1e-12:
     bad.append(f"orbit: periodic {s.get('orbit_periodic')}, period {s.get('orbit_period_strain')}")
+first_rows = (work / "quasistatic.csv").read_text().splitlines()
+again = subprocess.run(base + ["--strain", "0.005", "--increment", "1e-3"], capture_output=True, text=True)
+if again.returncode != 2 or "--resume" not in again.stderr:
+    bad.append(f"a second run into the same --out: exit {again.returncode}, stderr {again.stderr.strip()!r}")
+ext = subprocess.run(base + ["--strain", "0.007", "--increment", "1e-3", "--resume"], capture_output=True, text=True)
+ext_rows = (work / "quasistatic.csv").read_text().splitlines()
+if ext.returncode != 0 or len(ext_rows) != 9 or ext_rows[:7] != first_rows:
+    bad.append(f"--resume --strain 0.007: exit {ext.returncode}, {len(ext_rows) - 1} rows, first rows kept: "
+               f"{ext_rows[:7] == first_rows}; {ext.stderr.strip()}")
+if json.loads((work / "summary.json").read_text())["minima"] != 8:
+    bad.append("summary.json of the extended run does not count 8 minima")
+other = subprocess.run(base + ["--strain", "0.007", "--increment", "5e-4", "--resume"], capture_output=True, text=True)
+if other.returncode != 3 or "quasistatic.strain_increment" not in other.stderr:
+    bad.append(f"--resume with another increment: exit {other.returncode}, stderr {other.stderr.strip()!r}")
 print("\n".join(bad) if bad else f"mrf quasistatic: {len(rows)} minima, all checks passed")
 sys.exit(1 if bad else 0)

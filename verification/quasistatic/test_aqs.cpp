@@ -13,6 +13,8 @@
 #include "mrf/error.hpp"
 #include "mrf/forces/hertz.hpp"
 #include "mrf/quasistatic/aqs.hpp"
+#include "mrf/io/archive.hpp"
+#include "support/files.hpp"
 #include "support/iron_pair.hpp"
 #include "support/small_scene.hpp"
 
@@ -127,6 +129,72 @@ TEST(QuasistaticSmallScene, UnconvergedMinimisationStopsTheRun) {
     const std::string what = e.what();
     EXPECT_NE(what.find("increment 0"), std::string::npos) << what;
     EXPECT_NE(what.find("quasistatic.max_iterations"), std::string::npos) << what;
+  }
+}
+
+// A run checkpointed after two minima and restored into a fresh run of
+// the same scene continues bit for bit: the same minima, iterations and
+// stresses as the run that never stopped; a larger total strain extends a
+// finished run; a checkpoint of another increment is refused by name.
+TEST(QuasistaticResume, RestoredRunContinuesBitForBitAndExtends) {
+  const LoadedScene scene = test::scene({"contact.youngs_modulus=\"2 GPa\""});
+  QuasistaticOptions o = smoke_options();
+  o.strain = 3e-3;  // a coarse tolerance and few increments: the test is the continuation, not the physics
+  o.force_tol = 1e-4;
+  test::TempDir dir("aqs_resume");
+  const std::string ckpt = (dir.path() / "checkpoint.bin").string();
+  QuasistaticRun first = quasistatic_run(scene, o);  // the run that never stops, saved on the way
+  for (int k = 0; k < 2; ++k) first.step();
+  {
+    ArchiveWriter w(ckpt);
+    first.save(w);
+    w.close();
+  }
+  while (!first.done()) first.step();
+  const QuasistaticResult straight = first.finish();
+  QuasistaticRun resumed = quasistatic_run(scene, o);
+  {
+    ArchiveReader in(ckpt);
+    resumed.load(in);
+    in.expect_end();
+  }
+  EXPECT_EQ(resumed.next_increment(), 2u);
+  while (!resumed.done()) resumed.step();
+  const QuasistaticResult r = resumed.finish();
+  ASSERT_EQ(r.strain.size(), straight.strain.size());
+  for (std::size_t k = 0; k < r.strain.size(); ++k) {
+    EXPECT_EQ(r.stress_wall[k], straight.stress_wall[k]) << "minimum " << k;
+    EXPECT_EQ(r.stress_virial[k], straight.stress_virial[k]) << "minimum " << k;
+    EXPECT_EQ(r.energy[k], straight.energy[k]) << "minimum " << k;
+    EXPECT_EQ(r.iterations[k], straight.iterations[k]) << "minimum " << k;
+  }
+  EXPECT_EQ(r.force_evaluations, straight.force_evaluations);
+  for (std::size_t i = 0; i < r.final_cell.free.size(); ++i)
+    ASSERT_EQ(r.final_cell.free.x[i], straight.final_cell.free.x[i]) << "particle " << i;
+
+  // Extension: the checkpoint of two minima resumed with a larger strain.
+  QuasistaticOptions longer = o;
+  longer.strain = 4e-3;
+  QuasistaticRun extended = quasistatic_run(scene, longer);
+  {
+    ArchiveReader in(ckpt);
+    extended.load(in);
+  }
+  while (!extended.done()) extended.step();
+  const QuasistaticResult e = extended.finish();
+  ASSERT_EQ(e.strain.size(), 5u);
+  for (std::size_t k = 0; k < straight.strain.size(); ++k) EXPECT_EQ(e.stress_wall[k], straight.stress_wall[k]);
+  EXPECT_NEAR(e.strain.back(), 4e-3, 1e-15);
+
+  QuasistaticOptions other = o;
+  other.strain_increment = 5e-4;
+  QuasistaticRun refused = quasistatic_run(scene, other);
+  try {
+    ArchiveReader in(ckpt);
+    refused.load(in);
+    FAIL() << "no error";
+  } catch (const NumericalError& err) {
+    EXPECT_NE(std::string(err.what()).find("quasistatic.strain_increment"), std::string::npos) << err.what();
   }
 }
 

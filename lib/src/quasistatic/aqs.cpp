@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <stdexcept>
 #include <string>
 
 #include "mrf/error.hpp"
@@ -181,59 +183,117 @@ QuasistaticPoint measure(const QuasistaticState& s) {
   return pt;
 }
 
-QuasistaticResult run_quasistatic(ShearCell cell, const DemParams& p, const QuasistaticOptions& o,
-                                  const QuasistaticObserver& observer) {
-  o.validate();
-  if (!o.strain || !o.warmup_strain)
+QuasistaticRun::QuasistaticRun(ShearCell cell, const DemParams& p, const QuasistaticOptions& o)
+    : o_(o), t0_(std::chrono::steady_clock::now()) {
+  o_.validate();
+  if (!o_.strain || !o_.warmup_strain)
     throw InputError("quasistatic.strain", "", "", "the total and warm-up strain must be given for a cell built by hand");
-  const auto t0 = std::chrono::steady_clock::now();
-  const double rc = o.dipole_cutoff > 0 ? o.dipole_cutoff : p.dipole_cutoff;
+  const double rc = o_.dipole_cutoff > 0 ? o_.dipole_cutoff : p.dipole_cutoff;
+  o_.dipole_cutoff = rc;
   check_cutoff(rc, p, cell.box, "quasistatic.dipole_cutoff", "");
-  const FireOptions fire = quasistatic_fire_options(p, o);
-  fire.validate("quasistatic.fire.");
-  QuasistaticState s = make_quasistatic_state(std::move(cell), p, rc);
-  QuasistaticResult r;
-  r.force_scale = p.contact_force;
-  r.force_tol = fire.force_tol;
-  r.dipole_cutoff = rc;
-  const Box& box = s.cell.box;
-  r.stress_scale = static_cast<double>(s.cell.free.size()) * sphere_volume(p.radius) / box.volume() * k_mu0 *
-                   std::pow(p.moment / sphere_volume(p.radius), 2);
-  r.equilibrium_bound = static_cast<double>(s.cell.free.size()) * 0.5 * box.gap * fire.force_tol / box.volume();
-  r.orbit_period_strain = box.lz / box.gap;
-  const auto n_inc = static_cast<std::size_t>(std::ceil(*o.strain / o.strain_increment - 1e-9));
-  for (std::size_t k = 0; k <= n_inc; ++k) {
-    const double strain = static_cast<double>(k) * o.strain_increment;
-    if (k > 0) apply_strain_increment(s, o.strain_increment, o.affine);
-    const FireResult fr = relax(s, fire, k, strain);
-    QuasistaticPoint pt = measure(s);
-    pt.increment = k;
-    pt.strain = strain;
-    pt.iterations = fr.iterations;
-    r.force_evaluations += fr.iterations + 1;
-    record(r, pt);
-    if (observer) observer(pt);
-  }
-  steady_averages(r, *o.warmup_strain);
-  r.list_builds = s.lists.builds;
-  r.final_cell = std::move(s.cell);
-  r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return r;
+  fire_ = quasistatic_fire_options(p, o_);
+  fire_.validate("quasistatic.fire.");
+  s_ = make_quasistatic_state(std::move(cell), p, rc);
+  r_.force_scale = p.contact_force;
+  r_.force_tol = fire_.force_tol;
+  r_.dipole_cutoff = rc;
+  const Box& box = s_.cell.box;
+  r_.stress_scale = static_cast<double>(s_.cell.free.size()) * sphere_volume(p.radius) / box.volume() * k_mu0 *
+                    std::pow(p.moment / sphere_volume(p.radius), 2);
+  r_.equilibrium_bound = static_cast<double>(s_.cell.free.size()) * 0.5 * box.gap * fire_.force_tol / box.volume();
+  r_.orbit_period_strain = box.lz / box.gap;
+  n_increments_ = static_cast<std::size_t>(std::ceil(*o_.strain / o_.strain_increment - 1e-9));
 }
 
-QuasistaticResult run_quasistatic(const LoadedScene& scene, const QuasistaticOptions& o,
+QuasistaticPoint QuasistaticRun::step() {
+  if (done()) throw std::logic_error("QuasistaticRun::step after the last increment");
+  const std::size_t k = next_;
+  const double strain = static_cast<double>(k) * o_.strain_increment;
+  if (k > 0) apply_strain_increment(s_, o_.strain_increment, o_.affine);
+  const FireResult fr = relax(s_, fire_, k, strain);
+  QuasistaticPoint pt = measure(s_);
+  pt.increment = k;
+  pt.strain = strain;
+  pt.iterations = fr.iterations;
+  r_.force_evaluations += fr.iterations + 1;
+  record(r_, pt);
+  ++next_;
+  return pt;
+}
+
+double QuasistaticRun::wall_seconds() const {
+  return seconds_before_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
+}
+
+QuasistaticResult QuasistaticRun::finish() {
+  steady_averages(r_, *o_.warmup_strain);
+  r_.list_builds = s_.lists.builds;
+  r_.final_cell = std::move(s_.cell);
+  r_.wall_seconds = wall_seconds();
+  return std::move(r_);
+}
+
+void QuasistaticRun::save(ArchiveWriter& out) const {
+  out.io(o_.strain_increment, o_.force_tol, static_cast<std::uint8_t>(o_.affine), o_.dipole_cutoff);
+  serialize(out, *this);
+  out.put(wall_seconds());
+}
+
+void QuasistaticRun::load(ArchiveReader& in) {
+  double increment = 0, tol = 0, cutoff = 0;
+  std::uint8_t affine = 0;
+  in.io(increment, tol, affine, cutoff);
+  const auto refuse = [&](const std::string& key, const std::string& saved, const std::string& now) {
+    throw NumericalError("checkpoint " + in.path() + " was written with quasistatic." + key + " = " + saved +
+                         ", this run asks for " + now + ": start a new run (another --out) or resume with the same value");
+  };
+  if (increment != o_.strain_increment) refuse("strain_increment", format_short(increment), format_short(o_.strain_increment));
+  if (tol != o_.force_tol) refuse("force_tol", format_short(tol), format_short(o_.force_tol));
+  if ((affine != 0) != o_.affine) refuse("affine", affine ? "on" : "off", o_.affine ? "on" : "off");
+  if (cutoff != o_.dipole_cutoff) refuse("dipole_cutoff", format_short(cutoff) + " m", format_short(o_.dipole_cutoff) + " m");
+  const std::size_t n_free = s_.cell.free.size(), n_wall = s_.cell.walls.size();
+  serialize(in, *this);
+  in.get(seconds_before_);
+  t0_ = std::chrono::steady_clock::now();
+  if (s_.cell.free.x.size() != n_free || s_.cell.walls.x.size() != n_wall)
+    throw NumericalError("checkpoint " + in.path() + " holds " + std::to_string(s_.cell.free.x.size()) + " free and " +
+                         std::to_string(s_.cell.walls.x.size()) + " wall spheres, the scene builds " +
+                         std::to_string(n_free) + " and " + std::to_string(n_wall));
+  if (r_.strain.size() != next_)
+    throw NumericalError("checkpoint " + in.path() + " is inconsistent: " + std::to_string(r_.strain.size()) +
+                         " minima recorded for " + std::to_string(next_) + " increments");
+}
+
+QuasistaticResult run_quasistatic(ShearCell cell, const DemParams& p, const QuasistaticOptions& o,
                                   const QuasistaticObserver& observer) {
+  QuasistaticRun run(std::move(cell), p, o);
+  while (!run.done()) {
+    const QuasistaticPoint pt = run.step();
+    if (observer) observer(pt);
+  }
+  return run.finish();
+}
+
+QuasistaticRun quasistatic_run(const LoadedScene& scene, const QuasistaticOptions& o) {
   const SceneConfig& c = scene.config;
   if (!(c.magnetization > 0))
     throw InputError("particles.magnetization", format_short(c.magnetization) + " A/m", scene.locate("particles.magnetization"),
                      "quasi-static shear needs magnetic particles (its force tolerance is relative to the dipole "
                      "contact force)");
-  const DemParams p = dem_params(c);
   QuasistaticOptions opt = o;
   if (!opt.strain) opt.strain = c.strain;
   if (!opt.warmup_strain) opt.warmup_strain = c.warmup_strain;
-  ShearCell cell = build_shear_cell(c, scene.locate("particles.volume_fraction"));
-  return run_quasistatic(std::move(cell), p, opt, observer);
+  return QuasistaticRun(build_shear_cell(c, scene.locate("particles.volume_fraction")), dem_params(c), opt);
+}
+
+QuasistaticResult run_quasistatic(const LoadedScene& scene, const QuasistaticOptions& o,
+                                  const QuasistaticObserver& observer) {
+  QuasistaticRun run = quasistatic_run(scene, o);
+  while (!run.done()) {
+    const QuasistaticPoint pt = run.step();
+    if (observer) observer(pt);
+  }
+  return run.finish();
 }
 
 }  // namespace mrf

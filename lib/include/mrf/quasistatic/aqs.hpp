@@ -21,11 +21,13 @@
 // minimum. A minimisation that does not converge is a NumericalError: the
 // run never continues from a non-minimum.
 #pragma once
+#include <chrono>
 #include <cstddef>
 #include <functional>
 #include <optional>
 #include <vector>
 
+#include "mrf/io/archive.hpp"
 #include "mrf/io/toml_scene.hpp"
 #include "mrf/neighbors/verlet_list.hpp"
 #include "mrf/observe/block_average.hpp"
@@ -140,13 +142,61 @@ QuasistaticPoint measure(const QuasistaticState& s);
 // Called at every accepted minimum (progress, frames); may be empty.
 using QuasistaticObserver = std::function<void(const QuasistaticPoint&)>;
 
-// The run on a cell built by hand (tests) or from a scene. `strain` and
+// One run, one accepted minimum at a time: what run_quasistatic loops over,
+// and what a run of hours checkpoints between minima. Between minima the
+// whole state is the cell (free and wall positions), its pair lists and the
+// series so far: FIRE starts afresh at every increment, so a run restored by
+// load() continues bit for bit (verification/quasistatic/test_aqs.cpp).
+class QuasistaticRun {
+ public:
+  // `strain` and `warmup_strain` of the options must be set.
+  QuasistaticRun(ShearCell cell, const DemParams& p, const QuasistaticOptions& o);
+  bool done() const { return next_ > n_increments_; }
+  std::size_t next_increment() const { return next_; }
+  std::size_t increments() const { return n_increments_; }  // the last increment; 0 is the initial minimum
+  const QuasistaticOptions& options() const { return o_; }  // as run: the cut-off resolved
+  // Applies the next increment (none for the initial minimum), relaxes to a
+  // minimum and records it; NumericalError if FIRE does not converge.
+  QuasistaticPoint step();
+  const QuasistaticResult& series() const { return r_; }  // the minima so far
+  double wall_seconds() const;  // so far, over every session of a resumed run
+  // The steady means over the minima so far and the final cell; the run is spent.
+  QuasistaticResult finish();
+
+  // The increment, tolerance, affine start and cut-off are part of the
+  // state: load() refuses (NumericalError naming the option and both values)
+  // a checkpoint written with others. The total strain may differ: a run
+  // is extended by resuming it with a larger one.
+  void save(ArchiveWriter& out) const;
+  void load(ArchiveReader& in);
+
+ private:
+  template <class Archive, class Self>
+  static void serialize(Archive& ar, Self& q) {
+    auto& r = q.r_;  // const for the writer: one field list for both directions
+    ar.io(q.s_.cell.free.x, q.s_.cell.walls.x, q.s_.lists, q.next_, r.strain,
+          r.stress_wall, r.stress_virial, r.stress_virial_magnetic, r.stress_virial_contact, r.energy, r.max_force,
+          r.max_overlap, r.iterations, r.force_evaluations);
+  }
+  QuasistaticState s_;
+  QuasistaticOptions o_;
+  FireOptions fire_;
+  QuasistaticResult r_;
+  std::size_t n_increments_ = 0, next_ = 0;
+  double seconds_before_ = 0;  // wall seconds of earlier sessions (resumed runs)
+  std::chrono::steady_clock::time_point t0_;
+};
+
+// The run of a scene: the cell of build_shear_cell(scene) (the builder
+// every model uses), DemParams from dem_params(scene.config), the strain
+// and warm-up of drive.* unless the options set them; a magnetisation of 0
+// is refused (no force scale), as is a cut-off that breaks the minimum image.
+QuasistaticRun quasistatic_run(const LoadedScene& scene, const QuasistaticOptions& o);
+
+// The whole run on a cell built by hand (tests) or from a scene. `strain` and
 // `warmup_strain` of the options must be set for the first form.
 QuasistaticResult run_quasistatic(ShearCell cell, const DemParams& p, const QuasistaticOptions& o,
                                   const QuasistaticObserver& observer = {});
-// The cell of build_shear_cell(scene) (the builder every model uses),
-// DemParams from dem_params(scene.config); a magnetisation of 0 is refused
-// (no force scale), as is a cut-off that breaks the minimum image.
 QuasistaticResult run_quasistatic(const LoadedScene& scene, const QuasistaticOptions& o,
                                   const QuasistaticObserver& observer = {});
 
