@@ -7,6 +7,12 @@ every point, flow fits and cost per strain unit. Written for a sweep that is
 still running: it reports what has finished and says what has not.
 
 usage: paper_study.py SWEEP_DIR OUT_DIR [--small reports/study/flow_curves.csv]
+                      [--quasistatic reports/quasistatic/paper/results.csv]
+
+The quasi-static (AQS, Mn -> 0) wall stress of the same cell, when its
+results table exists (columns run, stress_over_phi_mu0_m2, err, note; one
+row per AQS run, the headline first), is drawn at the left edge of both
+panels and tabulated beside the lowest-Mn particle stresses.
 
 SWEEP_DIR holds sweep.csv (mrf sweep ... --collect) and criterion.json
 (mrf criterion SWEEP_DIR). Writes OUT_DIR/paper.md and its figures.
@@ -56,6 +62,8 @@ def main(argv):
     if os.path.exists(small_path):
         for r in read_rows(small_path):
             small[r["model"]][float(r["mason"])] = (num(r, "stress_Pa"), num(r, "err_Pa"))
+    qs_path = arg(argv, "--quasistatic", os.path.join(here, "quasistatic", "paper", "results.csv"))
+    qs = list(read_rows(qs_path)) if os.path.exists(qs_path) else []
     small_m = 1e6  # the small-cell study's fixed magnetisation (experiments/sweeps/default.toml)
     gdot = num(rows[0], "shear_rate") if rows else float("nan")
 
@@ -76,6 +84,14 @@ def main(argv):
                             yerr=[small[k][m][1] / (phi * MU0 * small_m ** 2) for m in xs], fmt="x:", ms=4,
                             capsize=2, color=COLOR[k], alpha=0.6, label=LABEL[k] + " (small cell, fixed M)")
     for ax in axs:
+        if qs:  # the AQS headline at the left edge, the other runs as its spread
+            v, e = num(qs[0], "stress_over_phi_mu0_m2"), num(qs[0], "err")
+            ax.errorbar([8e-4], [v], yerr=[e], fmt="*", ms=10, color="k", capsize=3,
+                        label=f"quasi-static (AQS, Mn -> 0): {qs[0]['run']}")
+            others = [num(r, "stress_over_phi_mu0_m2") for r in qs[1:]]
+            if others:
+                ax.plot([8e-4] * len(others), others, "k.", ms=4, alpha=0.5, label="AQS variants (increment, tol, "
+                        "cut-off, seed, Y)")
         ax.axhline(CHAIN_YIELD, color="k", ls="--", lw=1, label="chain model yield 0.137")
         sources = sorted({e[0] for e in expt})
         for src in sources:
@@ -165,6 +181,29 @@ def main(argv):
                 cmp3 = f"{vol / w3 - 1:+.3f}"
             lines.append(f"| {k} | {m:g} | {len(rs)} | {wall:.4f} | {vol:.4f} | {1 - wall / vol:+.3f} | {cmp3} |")
     lines.append("")
+    if qs:
+        lines += ["## The quasi-static limit (issue 17)", "",
+                  "AQS wall stress of the paper cell (mrf quasistatic; reports/quasistatic/paper/), in φμ0M², beside "
+                  "the particle part of each model's wall stress and model 1's volume side less eta gdot at the "
+                  "lowest Mn run. In AQS there is no carrier and wall = virial at every minimum.", "",
+                  "| AQS run | stress / (phi mu0 M^2) | note |", "|---|---:|---|"]
+        for r in qs:
+            lines.append(f"| {r['run']} | {num(r, 'stress_over_phi_mu0_m2'):.5f} ± {num(r, 'err'):.5f} | "
+                         f"{r.get('note', '')} |")
+        lines += ["", "| model | lowest Mn | particle part of the wall stress | volume side - eta gdot |",
+                  "|---|---:|---:|---:|"]
+        for k in models:
+            p = crit["models"][k]["points"]
+            if not p:
+                continue
+            q = min(p, key=lambda q: q["mason"])
+            sc = phi * MU0 * q["magnetization"] ** 2
+            rs = by.get((k, q["mason"]), [])
+            vol = (sum(num(r, "stress_virial_total") - num(r, "stress_fluid") for r in rs) / len(rs) / sc
+                   if rs and k == "dem_stokes" else float("nan"))
+            lines.append(f"| {k} | {q['mason']:g} | {(q['stress'] - q['stress_fluid']) / sc:.5f} ± "
+                         f"{q['err'] / sc:.5f} | {'–' if math.isnan(vol) else f'{vol:.5f}'} |")
+        lines.append("")
     lines += ["## Flow-curve fits (mrf criterion)", "",
               "| model | Bingham Mn* | power-law Mn* | Delta | chi2/dof | note |", "|---|---:|---:|---:|---:|---|"]
     for k in models:
