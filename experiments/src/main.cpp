@@ -101,7 +101,7 @@ int sweep_command(const SweepArgs& a) {
     // index, folder, state and estimate of every point: what a job array or
     // GNU parallel needs to hand `--point K` out
     const auto points = mrf::sweep_points(spec);
-    const mrf::PointEstimates est = mrf::estimate_points(spec, points, out, opt.cost_rate);
+    const mrf::PointEstimates est = mrf::estimate_points(spec, points, out, opt.cost_rate, a.archive);
     std::printf("%-5s %-40s %-14s %-9s %-5s %-9s %s\n", "point", "folder", "model", "Mn", "seed", "state",
                 "estimate (s; * = from the particle-steps model, no point of the model finished)");
     for (const auto& p : points) {
@@ -118,7 +118,7 @@ int sweep_command(const SweepArgs& a) {
   }
   if (a.estimate) {
     const auto points = mrf::sweep_points(spec);
-    const mrf::PointEstimates est = mrf::estimate_points(spec, points, out, opt.cost_rate);
+    const mrf::PointEstimates est = mrf::estimate_points(spec, points, out, opt.cost_rate, a.archive);
     double total = 0;
     std::size_t model_only = 0;
     for (const auto& p : points) {
@@ -128,8 +128,9 @@ int sweep_command(const SweepArgs& a) {
       model_only += est.calibrated[p.index] ? 0 : 1;
     }
     std::printf("total %.3g s (%.3g h) on one core; %zu points (*) from the particle-steps model at %.3g "
-                "particle-steps/s, the rest from the finished points in %s\n",
-                total, total / 3600, model_only, opt.cost_rate, out.c_str());
+                "particle-steps/s, the rest from the finished points in %s%s\n",
+                total, total / 3600, model_only, opt.cost_rate, out.c_str(),
+                a.archive.empty() ? "" : (" and " + a.archive).c_str());
     return 0;
   }
 #ifdef MRF_HAVE_MPI

@@ -177,6 +177,12 @@ TEST(Sweep, KilledSweepResumesAndReproduces) {
   EXPECT_DOUBLE_EQ(est.seconds[2], read_json(p1 / "summary.json")["seconds_per_strain"].get<double>() * 0.6);
   const PointEstimates fresh = estimate_points(wider, pts, (out / "nothing_here").string(), 1e6);
   EXPECT_FALSE(fresh.calibrated[2]);
+  // An empty out_dir beside an archive of finished points (what `--point K
+  // --archive DIR` sees on a new machine): calibrated by the archive's
+  // seconds per strain unit, the point's own entry first.
+  const PointEstimates archived = estimate_points(wider, pts, (out / "nothing_here").string(), 1e6, out.string());
+  EXPECT_TRUE(archived.calibrated[1] && archived.calibrated[2]);
+  EXPECT_DOUBLE_EQ(archived.seconds[1], read_json(p1 / "summary.json")["seconds_per_strain"].get<double>() * 0.6);
 
   // `--point K` (what a job array hands out) runs point K alone, into the
   // same folder with the same result; a K outside the grid is refused.

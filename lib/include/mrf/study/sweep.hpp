@@ -125,13 +125,15 @@ double estimate_point_seconds(const std::string& scene_path, const std::vector<s
 // seconds_per_strain of the finished point of the same model nearest in
 // log Mn, times its strain (the particle-steps estimate, which is blind to
 // the implicit schemes' step sizes, only where no point of the model has
-// finished). `calibrated[k]` says which of the two an estimate is.
+// finished). `calibrated[k]` says which of the two an estimate is. With an
+// archive (--archive), its summaries calibrate too, by their seconds per
+// strain unit, where out_dir has none.
 struct PointEstimates {
   std::vector<double> seconds;
   std::vector<char> calibrated;
 };
 PointEstimates estimate_points(const SweepSpec& spec, const std::vector<SweepPoint>& points, const std::string& out_dir,
-                               double cost_rate);
+                               double cost_rate, const std::string& archive_dir = {});
 
 // Runs this rank's unfinished points one after another into out_dir/<point.dir>
 // (every scene is loaded and validated before the first run, and so is the
