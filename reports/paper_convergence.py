@@ -1,0 +1,90 @@
+#!/usr/bin/python3
+"""Issue 13's convergence table: how far the paper-scale stress moves with
+each numerical choice (experiments/sweeps/paper_convergence.toml), against
+the base, the three-seed means of the paper-scale sweep at the same model
+and Mn (reports/study/paper/sweep.csv).
+
+usage: paper_convergence.py CONVERGENCE_SWEEP_CSV [BASE_SWEEP_CSV] [OUT_MD]
+  defaults: reports/study/paper/sweep.csv, reports/study/paper/convergence.md
+
+Each variant is one seed. Its error is the larger of its within-run error
+and the base's seed scatter (the standard deviation over the base's seeds:
+a single seed of the variant scatters as a single seed of the base does);
+the base's error is max(within-run, seed scatter / sqrt(n)). The shift is
+quoted in per cent of the base and in combined standard errors. A variant
+whose own run is not steady (drift |z| >= 3 or MSER-5 discard >= 0.2) is
+marked: its shift is then not yet a measurement.
+"""
+import csv
+import math
+import os
+import statistics
+import sys
+from collections import defaultdict
+
+MU0 = 4e-7 * math.pi
+DRIFT_Z, MSER_MAX = 3.0, 0.2
+
+
+def rows(path):
+    return [r for r in csv.DictReader(open(path)) if r["status"] == "ok"]
+
+
+def f(r, k):
+    try:
+        return float(r[k])
+    except (KeyError, ValueError):
+        return float("nan")
+
+
+def main(argv):
+    if len(argv) < 2:
+        print(__doc__)
+        return 2
+    here = os.path.dirname(os.path.abspath(__file__))
+    conv = rows(argv[1])
+    base_rows = rows(argv[2] if len(argv) > 2 else os.path.join(here, "study", "paper", "sweep.csv"))
+    out = argv[3] if len(argv) > 3 else os.path.join(here, "study", "paper", "convergence.md")
+    base = defaultdict(list)
+    for r in base_rows:
+        base[(r["model"], float(r["mason"]))].append(r)
+    lines = ["# Convergence of the paper-scale stress (issue 13)", "",
+             "experiments/sweeps/paper_convergence.toml: one numerical choice changed per variant, one seed, on the "
+             "realistic path (1000 1/s, M from Mn) and the base's strain rules; written by reports/paper_convergence.py. "
+             "Stress in phi mu0 M^2 (M the point's own). Base: the seed mean of reports/study/paper/sweep.csv at the "
+             "same model and Mn, error max(within-run, seed scatter / sqrt(n)). Variant error: max(within-run, the "
+             "base's seed standard deviation). Shift = variant / base - 1, and in combined standard errors.", "",
+             "| model | Mn | variant | wall stress | base (seeds) | shift | shift / sigma | particle part shift | "
+             "variant steady | s per strain |", "|---|---:|---|---:|---:|---:|---:|---:|---|---:|"]
+    for r in sorted(conv, key=lambda r: (r["model"], float(r["mason"]), r["variant"])):
+        key = (r["model"], float(r["mason"]))
+        b = base.get(key, [])
+        phi = f(r, "volume_fraction")
+        sc = (phi if phi == phi else 0.30) * MU0 * f(r, "magnetization") ** 2
+        t, e = f(r, "stress_total") / sc, f(r, "stress_total_err") / sc
+        steady = abs(f(r, "stress_total_drift_z")) < DRIFT_Z and f(r, "steady_mser_discard_fraction") < MSER_MAX
+        per = f(r, "wall_seconds") / f(r, "strain")
+        if not b:
+            lines.append(f"| {r['model']} | {key[1]:g} | {r['variant']} | {t:.5f} ± {e:.5f} | – | – | – | – | "
+                         f"{'yes' if steady else '**no**'} | {per:.3g} |")
+            continue
+        bt = [f(x, "stress_total") / sc for x in b]
+        bp = [(f(x, "stress_total") - f(x, "stress_fluid")) / sc for x in b]
+        within = max(f(x, "stress_total_err") for x in b) / sc
+        sd = statistics.stdev(bt) if len(bt) > 1 else 0.0
+        bm, be = statistics.mean(bt), max(within, sd / math.sqrt(len(bt)))
+        ve = max(e, sd)
+        pm = statistics.mean(bp)
+        vp = (f(r, "stress_total") - f(r, "stress_fluid")) / sc
+        z = (t - bm) / math.hypot(be, ve)
+        lines.append(f"| {r['model']} | {key[1]:g} | {r['variant']} | {t:.5f} ± {ve:.5f} | {bm:.5f} ± {be:.5f} "
+                     f"({len(bt)}) | {100 * (t / bm - 1):+.1f} % | {z:+.1f} | {100 * (vp / pm - 1):+.1f} % | "
+                     f"{'yes' if steady else '**no**'} | {per:.3g} |")
+    with open(out, "w") as fh:
+        fh.write("\n".join(lines) + "\n")
+    print(f"-> {out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
