@@ -57,7 +57,6 @@ int quasistatic_command(const std::string& scene_path, const std::vector<std::st
     throw mrf::InputError("--checkpoint-every", std::to_string(cli.checkpoint_seconds), "", "must be >= 0 (0 = none)");
   mrf::QuasistaticRun run = mrf::quasistatic_run(scene, options);
   const mrf::QuasistaticOptions& opt = run.options();
-  const bool quiet = cli.quiet;
   const std::string id = mrf::scene_id(scene.config), ckpt = out + "/checkpoint.bin";
   std::filesystem::create_directories(out);
   if (cli.resume && std::filesystem::exists(ckpt)) {
@@ -69,13 +68,13 @@ int quasistatic_command(const std::string& scene_path, const std::vector<std::st
                                 ": resume with the same scene and overrides, or start a new run (another --out)");
     run.load(in);
     in.expect_end();
-    if (!quiet)
+    if (!cli.quiet)
       std::fprintf(stderr, "mrf quasistatic: resumed from %s at increment %zu of %zu (%.0f s spent)\n", ckpt.c_str(),
                    run.next_increment(), run.increments(), run.wall_seconds());
   } else if (!cli.resume && std::filesystem::exists(ckpt)) {
     throw mrf::InputError("--out", out, "", "holds a checkpoint of an earlier run: --resume continues it, or choose another --out");
   }
-  if (!quiet)
+  if (!cli.quiet)
     std::fprintf(stderr, "mrf quasistatic: %s, increments of %g to strain %g, max |f| < %g F0, affine %s\n",
                  scene_path.c_str(), opt.strain_increment, *opt.strain, opt.force_tol, opt.affine ? "on" : "off");
   const std::size_t first = run.next_increment();
@@ -84,7 +83,7 @@ int quasistatic_command(const std::string& scene_path, const std::vector<std::st
   while (!run.done()) {
     const mrf::QuasistaticPoint p = run.step();
     const double t = run.wall_seconds();
-    if (!quiet) {
+    if (!cli.quiet) {
       const double per = (t - t_first) / static_cast<double>(run.next_increment() - first);
       std::fprintf(stderr, "\r  strain %.4f / %g  wall %.4g Pa  virial %.4g Pa  %ld FIRE iterations  %.0f s, about %.0f s left   ",
                    p.strain, *opt.strain, p.stress_wall, p.stress_virial, p.iterations, t,
@@ -95,12 +94,12 @@ int quasistatic_command(const std::string& scene_path, const std::vector<std::st
       t_saved = t;
     }
   }
-  if (!quiet) std::fprintf(stderr, "\n");
+  if (!cli.quiet) std::fprintf(stderr, "\n");
   write_checkpoint(run, id, out);  // kept: --resume with a larger --strain extends the run
   const mrf::QuasistaticResult r = run.finish();
   nlohmann::ordered_json j;
   j["driver"] = "quasistatic (AQS, FIRE 2.0)";
-  j["scene_id"] = mrf::scene_id(scene.config);
+  j["scene_id"] = id;
   j["strain_increment"] = opt.strain_increment;
   j["affine"] = opt.affine;
   j["force_tol_over_f0"] = opt.force_tol;

@@ -264,14 +264,20 @@ void QuasistaticRun::load(ArchiveReader& in) {
                          " minima recorded for " + std::to_string(next_) + " increments");
 }
 
-QuasistaticResult run_quasistatic(ShearCell cell, const DemParams& p, const QuasistaticOptions& o,
-                                  const QuasistaticObserver& observer) {
-  QuasistaticRun run(std::move(cell), p, o);
+namespace {
+QuasistaticResult run_to_end(QuasistaticRun& run, const QuasistaticObserver& observer) {
   while (!run.done()) {
     const QuasistaticPoint pt = run.step();
     if (observer) observer(pt);
   }
   return run.finish();
+}
+}  // namespace
+
+QuasistaticResult run_quasistatic(ShearCell cell, const DemParams& p, const QuasistaticOptions& o,
+                                  const QuasistaticObserver& observer) {
+  QuasistaticRun run(std::move(cell), p, o);
+  return run_to_end(run, observer);
 }
 
 QuasistaticRun quasistatic_run(const LoadedScene& scene, const QuasistaticOptions& o) {
@@ -289,11 +295,7 @@ QuasistaticRun quasistatic_run(const LoadedScene& scene, const QuasistaticOption
 QuasistaticResult run_quasistatic(const LoadedScene& scene, const QuasistaticOptions& o,
                                   const QuasistaticObserver& observer) {
   QuasistaticRun run = quasistatic_run(scene, o);
-  while (!run.done()) {
-    const QuasistaticPoint pt = run.step();
-    if (observer) observer(pt);
-  }
-  return run.finish();
+  return run_to_end(run, observer);
 }
 
 }  // namespace mrf

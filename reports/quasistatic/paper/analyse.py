@@ -4,11 +4,17 @@ block-average errors, the periodic-orbit test, results.csv for the study
 report (reports/paper_study.py) and the figure aqs_paper.png.
 
 Usage: /usr/bin/python3 reports/quasistatic/paper/analyse.py NAME=RUN_DIR[:FROM[:TO]] ... [--scale PA]
+                                                            [--label NAME=TEXT]...
+  --label: what the run's summary.json does not say (e.g. its Young's modulus),
+  put first in its note; the increment, tolerance, cut-off and seed come from
+  summary.json, and a lock on a short repeat (deviation < 1 %) is noted.
   The first run is the headline. RUN_DIR holds quasistatic.csv and summary.json
   of `mrf quasistatic` (a run still going has a partial CSV and no summary: its
   stress scale is then taken from the headline's, or from --scale). FROM/TO:
   the strain window of the mean (default: the run's warm-up from summary.json,
   or 0.2, to its last minimum).
+Also the shortest repeat over the last lz/gap of strain: the lag (in minima,
+up to 20) at which the stress repeats best, and how well.
 Writes results.csv, <headline>_quasistatic.csv (a copy of its per-minimum CSV)
 and aqs_paper.png beside this script.
 
@@ -63,8 +69,26 @@ def periodic(strain, wall, frm):
     return max(abs(a - b) for a, b in pairs) / scale
 
 
+def shortest_repeat(strain, wall, max_lag=20):
+    """Over the last lz/gap of strain: the lag (in minima) whose largest |w(k) - w(k - lag)| is smallest,
+    and that deviation / max|w|. A small value is an orbit locked on the wall lattice (README §5)."""
+    n = len(wall)
+    last = [k for k in range(n) if strain[k] >= strain[-1] - PERIOD]
+    best = None
+    for lag in range(1, max_lag + 1):
+        ks = [k for k in last if k - lag >= 0]
+        if not ks:
+            break
+        scale = max(abs(wall[k]) for k in ks)
+        dev = max(abs(wall[k] - wall[k - lag]) for k in ks) / scale
+        if best is None or dev < best[1]:
+            best = (lag, dev)
+    return best
+
+
 def main(argv):
-    specs = [a for a in argv[1:] if "=" in a]
+    labels = dict(argv[i + 1].split("=", 1) for i, a in enumerate(argv) if a == "--label")
+    specs = [a for i, a in enumerate(argv[1:], 1) if "=" in a and argv[i - 1] != "--label"]
     if not specs:
         print(__doc__)
         return 2
@@ -86,7 +110,7 @@ def main(argv):
             scale = scale or s["stress_scale"]
         runs.append(dict(name=name, dir=d, strain=strain, wall=wall, frm=frm, to=to, n=len(win),
                          mean=sum(win) / len(win) if win else float("nan"), err=block_error(win),
-                         dev=periodic(strain, wall, frm), done=bool(s), scale=s.get("stress_scale"),
+                         dev=periodic(strain, wall, frm), rep=shortest_repeat(strain, wall), done=bool(s), summary=s, scale=s.get("stress_scale"),
                          iters=sum(int(r["iterations"]) for r in rows), seconds=s.get("wall_seconds")))
     if scale is None:
         raise SystemExit("no summary.json among the runs: no stress scale (phi mu0 M^2)")
@@ -94,15 +118,29 @@ def main(argv):
     with open(out, "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["run", "stress_over_phi_mu0_m2", "err", "mean_Pa", "err_Pa", "from_strain", "to_strain",
-                    "minima_in_window", "periodic_deviation", "finished", "note"])
+                    "minima_in_window", "periodic_deviation", "repeat_lag", "repeat_deviation", "finished",
+                    "note"])
         for r in runs:
             sc = r["scale"] or scale
             dev = "" if r["dev"] is None else f"{r['dev']:.2e}"
-            note = ("periodic orbit: block error is no error bar" if r["dev"] is not None and r["dev"] < 1e-6
-                    else "") + ("" if r["done"] else ("; " if r["dev"] is not None and r["dev"] < 1e-6 else "")
-                               + "still running (partial CSV)")
+            parts = [labels[r["name"]]] if r["name"] in labels else []
+            if r["summary"]:
+                q = r["summary"]
+                parts.append(f"d {q['strain_increment']:g}, tol {q['force_tol_over_f0']:g} F0, "
+                             f"r_c {q['dipole_cutoff'] * 1e6:g} um, seed {q['seed']}")
+            parts.append(f"window {r['frm']:g}-{r['to']:g}")
+            if r["dev"] is not None and r["dev"] < 1e-6:
+                parts.append("periodic orbit (lz/gap): block error is no error bar")
+            elif r["rep"] and r["rep"][1] < 1e-2:
+                parts.append(f"repeats every {r['rep'][0]} minima at the end (deviation {r['rep'][1]:.1e}): "
+                             "block error of one realisation")
+            if not r["done"]:
+                parts.append("still running (partial CSV)")
+            note = "; ".join(parts)
             w.writerow([r["name"], f"{r['mean'] / sc:.6g}", f"{r['err'] / sc:.3g}", f"{r['mean']:.6g}",
-                        f"{r['err']:.3g}", f"{r['frm']:g}", f"{r['to']:g}", r["n"], dev, int(r["done"]), note])
+                        f"{r['err']:.3g}", f"{r['frm']:g}", f"{r['to']:g}", r["n"], dev,
+                        r["rep"][0] if r["rep"] else "", f"{r['rep'][1]:.2e}" if r["rep"] else "", int(r["done"]),
+                        note])
     head = runs[0]
     shutil.copy(os.path.join(head["dir"], "quasistatic.csv"), os.path.join(here, f"{head['name']}_quasistatic.csv"))
 
@@ -121,6 +159,8 @@ def main(argv):
     for r in runs:
         print(f"{r['name']}: {r['mean']:.1f} ± {r['err']:.1f} Pa = {r['mean'] / scale:.5f} phi mu0 M^2 over "
               f"{r['frm']:g}-{r['to']:g} ({r['n']} minima), periodic deviation {r['dev']}, "
+              f"shortest repeat over the last lz/gap: lag {r['rep'][0] if r['rep'] else '-'} "
+              f"(deviation {r['rep'][1] if r['rep'] else float('nan'):.2e}), "
               f"{r['iters']} FIRE iterations, {'finished' if r['done'] else 'running'}")
     return 0
 
