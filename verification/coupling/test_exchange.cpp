@@ -71,7 +71,9 @@ TEST(CouplingExchange, PairsAreTheSameOnAnyNumberOfThreads) {
     }
   }
   omp_set_num_threads(saved);
-  EXPECT_TRUE(std::is_sorted(one.begin(), one.end(), [](const CouplingPair& x, const CouplingPair& y) { return x.i < y.i; }));
+  EXPECT_TRUE(std::is_sorted(one.begin(), one.end(), [](const CouplingPair& x, const CouplingPair& y) {
+    return x.i != y.i ? x.i < y.i : x.a < y.a;
+  }));
 }
 
 // A box narrower than 4h: a pair interacts through two periodic images, and
@@ -95,6 +97,85 @@ TEST(CouplingExchange, PairsSumEveryPeriodicImageInNarrowBoxes) {
         for (int kz = -2; kz <= 2; ++kz)
           expect[i] += kernel_w((dem[i] - xa + Vec3(0.0, ky * c.box.ly, kz * c.box.lz)).norm(), c.h);
   for (std::size_t i = 0; i < dem.size(); ++i) EXPECT_NEAR(sum[i], expect[i], 1e-12 * expect[i]) << i;
+}
+
+// The Verlet cache of the coupling pairs (CouplingPairCache): DEM and SPH
+// points carried by a shear flow plus a random non-affine jitter, in a
+// normal box and in one narrower than 4h (two periodic images per pair).
+// At every step the pairs of the cached candidates equal a fresh search,
+// entry for entry and weight for weight, while the cache was rebuilt on
+// only some of the steps: the rebuild bound holds and the cache is used.
+TEST(CouplingExchange, CachedPairsEqualAFreshSearchAtEveryStep) {
+  for (const Box& box : {Box{24 * kDx, 12 * kDx, 12 * kDx}, Box{24 * kDx, 3 * kDx, 4 * kDx}}) {
+    FluidParams p;
+    p.viscosity = 0.1;
+    p.density = 1000.0;
+    p.spacing = kDx;
+    p.sound_speed = 1.0;
+    const FluidCell c = build_fluid_cell(box, p);
+    std::vector<Vec3> dem = random_points(300, -0.5 * box.gap, 0.5 * box.gap, box, 11), sph = c.fluid.x;
+    CouplingPairCache cache;
+    cache.skin = 0.3 * c.h;
+    std::mt19937_64 gen(3);
+    std::normal_distribution<double> jitter(0.0, 0.01 * c.h);
+    const double d_strain = 2e-3;
+    auto move = [&](std::vector<Vec3>& x) {
+      for (Vec3& q : x) {
+        q += Vec3(jitter(gen), jitter(gen), d_strain * q.x() + jitter(gen));
+        q.y() -= box.ly * std::floor(q.y() / box.ly);
+        q.z() -= box.lz * std::floor(q.z() / box.lz);
+      }
+    };
+    std::vector<CouplingPair> cached;
+    const int steps = 200;
+    for (int step = 0; step < steps; ++step) {
+      if (coupling_cache_stale(cache, dem, sph, box, c.h)) rebuild_coupling_cache(cache, dem, sph, box, c.h);
+      coupling_pairs_of(cache.candidates, dem, sph, box, c.h, cached);
+      const auto fresh = coupling_pairs(dem, sph, box, c.h);
+      ASSERT_EQ(cached.size(), fresh.size()) << "step " << step;
+      for (std::size_t k = 0; k < fresh.size(); ++k) {
+        ASSERT_EQ(cached[k].i, fresh[k].i) << k;
+        ASSERT_EQ(cached[k].a, fresh[k].a) << k;
+        ASSERT_EQ(cached[k].w, fresh[k].w) << k;
+      }
+      move(dem);
+      move(sph);
+      cache.strain += d_strain;
+    }
+    EXPECT_GT(cache.builds, 2) << "the bound never asked for a rebuild: the test does not test it";
+    EXPECT_LT(cache.builds, steps / 4) << "the cache is rebuilt too often to be worth it";
+  }
+}
+
+// The bound itself: one SPH point moved (non-affinely) by more than the
+// skin makes the cache stale, by less than half of it not; so does a
+// strain whose affine closing over the reach exceeds the skin.
+TEST(CouplingExchange, CacheIsStaleExactlyWhenTheSkinIsSpent) {
+  const FluidCell c = make_cell();
+  const auto dem = random_points(50, -0.5 * c.box.gap, 0.5 * c.box.gap, c.box, 2);
+  CouplingPairCache cache;
+  cache.skin = 0.3 * c.h;
+  EXPECT_TRUE(coupling_cache_stale(cache, dem, c.fluid.x, c.box, c.h)) << "never built";
+  rebuild_coupling_cache(cache, dem, c.fluid.x, c.box, c.h);
+  EXPECT_FALSE(coupling_cache_stale(cache, dem, c.fluid.x, c.box, c.h));
+  auto sph = c.fluid.x;
+  sph[7].y() += 0.45 * cache.skin;
+  EXPECT_FALSE(coupling_cache_stale(cache, dem, sph, c.box, c.h));
+  sph[7].y() += 0.6 * cache.skin;
+  EXPECT_TRUE(coupling_cache_stale(cache, dem, sph, c.box, c.h));
+  // points carried affinely by the strain (z += strain x): only the
+  // closing |strain| reach of the bound counts
+  const double reach = k_kernel_support * c.h + cache.skin;
+  auto sheared = [&](std::vector<Vec3> x, double strain) {
+    for (Vec3& q : x) q.z() += strain * q.x();
+    return x;
+  };
+  for (double f : {0.9, 1.1}) {
+    cache.strain = f * cache.skin / reach;
+    EXPECT_EQ(coupling_cache_stale(cache, sheared(dem, cache.strain), sheared(c.fluid.x, cache.strain), c.box, c.h),
+              f > 1)
+        << "strain " << f << " x skin / reach";
+  }
 }
 
 // (1a) Random DEM particles at solid fraction phi = 0.2 filling the slab and

@@ -10,21 +10,21 @@
 #include "mrf/error.hpp"
 #include "mrf/fluid/kernel.hpp"
 #include "mrf/neighbors/cell_list.hpp"
+#include "mrf/neighbors/verlet_list.hpp"
 
 namespace mrf {
 
 namespace {
 // DEM particles per thread below which the pair search stays serial
 constexpr std::size_t k_coupling_rows_per_thread = 1000;
+// candidates per thread below which their evaluation stays serial
+constexpr std::size_t k_coupling_candidates_per_thread = 50000;
 }  // namespace
 
-void coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x, const Box& box, double h,
-                    std::vector<CouplingPair>& out) {
-  if (!(h > 0.0)) throw std::invalid_argument("coupling_pairs: smoothing length h must be > 0");
-  const double rc = k_kernel_support * h, rc2 = rc * rc;
-  // Every periodic image closer than rc is its own entry: along y (z) a
-  // second image can interact only when ly (lz) < 2 rc = 4h.
-  const int ky = box.ly < 2.0 * rc ? 1 : 0, kz = box.lz < 2.0 * rc ? 1 : 0;
+void coupling_candidates(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x, const Box& box,
+                         double reach, std::vector<IndexPair>& out) {
+  if (!(reach > 0.0)) throw std::invalid_argument("coupling_candidates: reach must be > 0");
+  const double rc2 = reach * reach;
   double x_lo = 0.0, x_hi = 0.0;
   for (const Vec3& p : sph_x) {
     x_lo = std::min(x_lo, p.x());
@@ -34,42 +34,120 @@ void coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph
     x_lo = std::min(x_lo, p.x());
     x_hi = std::max(x_hi, p.x());
   }
-  CellGrid grid(box, x_lo - rc, x_hi + rc, rc);
+  CellGrid grid(box, x_lo - reach, x_hi + reach, reach);
   grid.bin(sph_x);
   const MinImageYZ mi(box);
   // DEM particles in contiguous blocks, one per thread, each filling its
-  // own list; the lists are joined in block order, so the pairs come in
-  // the same order (by DEM index) whatever the number of threads.
+  // own list; the lists are joined in block order, so the candidates come
+  // in the same order whatever the number of threads.
   const std::size_t n = dem_x.size();
   const int blocks = n >= k_coupling_rows_per_thread ? std::max(1, omp_get_max_threads()) : 1;
-  std::vector<std::vector<CouplingPair>> part(static_cast<std::size_t>(blocks));
+  std::vector<std::vector<IndexPair>> part(static_cast<std::size_t>(blocks));
 #pragma omp parallel for schedule(static, 1) if (blocks > 1)
   for (int blk = 0; blk < blocks; ++blk) {
-    std::vector<CouplingPair>& mine = blk == 0 ? out : part[static_cast<std::size_t>(blk)];
+    std::vector<IndexPair>& mine = blk == 0 ? out : part[static_cast<std::size_t>(blk)];
     mine.clear();
     const std::size_t lo = n * static_cast<std::size_t>(blk) / static_cast<std::size_t>(blocks);
     const std::size_t hi = n * static_cast<std::size_t>(blk + 1) / static_cast<std::size_t>(blocks);
     for (std::size_t ii = lo; ii < hi; ++ii) {
       const auto i = static_cast<std::uint32_t>(ii);
       const Vec3 xi = dem_x[i];
+      const std::size_t row = mine.size();
       grid.for_each_candidate(xi, [&](std::uint32_t a) {
         const Vec3& xa = sph_x[a];
-        const double dx = xi.x() - xa.x(), dx2 = dx * dx;
-        if (dx2 >= rc2) return;  // x is not periodic: cheap rejection first
+        const double dx = xi.x() - xa.x();
         const double dy = mi.wrap_y(xi.y() - xa.y()), dz = mi.wrap_z(xi.z() - xa.z());
-        for (int iz = -kz; iz <= kz; ++iz) {
-          const double ez = dz + iz * box.lz, rxz = dx2 + ez * ez;
-          if (rxz >= rc2) continue;
-          for (int iy = -ky; iy <= ky; ++iy) {
-            const double ey = dy + iy * box.ly, r2 = rxz + ey * ey;
-            if (r2 < rc2) mine.push_back({i, a, kernel_w(std::sqrt(r2), h)});
-          }
-        }
+        if (dx * dx + dy * dy + dz * dz < rc2) mine.emplace_back(i, a);
       });
+      std::sort(mine.begin() + static_cast<std::ptrdiff_t>(row), mine.end());
     }
   }
   for (int blk = 1; blk < blocks; ++blk) out.insert(out.end(), part[static_cast<std::size_t>(blk)].begin(),
                                                      part[static_cast<std::size_t>(blk)].end());
+}
+
+void coupling_pairs_of(const std::vector<IndexPair>& candidates, const std::vector<Vec3>& dem_x,
+                       const std::vector<Vec3>& sph_x, const Box& box, double h, std::vector<CouplingPair>& out) {
+  if (!(h > 0.0)) throw std::invalid_argument("coupling_pairs: smoothing length h must be > 0");
+  const double rc = k_kernel_support * h, rc2 = rc * rc;
+  // Every periodic image closer than rc is its own entry: along y (z) a
+  // second image can interact only when ly (lz) < 2 rc = 4h.
+  const bool ky = box.ly < 2.0 * rc, kz = box.lz < 2.0 * rc;
+  if ((ky && box.ly < rc) || (kz && box.lz < rc))
+    throw std::invalid_argument("coupling_pairs: periodic lengths below the kernel support 2h (ly " +
+                                std::to_string(box.ly) + " m, lz " + std::to_string(box.lz) + " m, 2h " +
+                                std::to_string(rc) + " m): a pair would interact through more than two images");
+  const MinImageYZ mi(box);
+  // contiguous blocks of candidates, one per thread, joined in block order
+  const std::size_t m = candidates.size();
+  const int blocks = m >= k_coupling_candidates_per_thread ? std::max(1, omp_get_max_threads()) : 1;
+  std::vector<std::vector<CouplingPair>> part(static_cast<std::size_t>(blocks));
+#pragma omp parallel for schedule(static, 1) if (blocks > 1)
+  for (int blk = 0; blk < blocks; ++blk) {
+    std::vector<CouplingPair>& mine = blk == 0 ? out : part[static_cast<std::size_t>(blk)];
+    mine.clear();
+    const std::size_t lo = m * static_cast<std::size_t>(blk) / static_cast<std::size_t>(blocks);
+    const std::size_t hi = m * static_cast<std::size_t>(blk + 1) / static_cast<std::size_t>(blocks);
+    mine.reserve(hi - lo);
+    const KernelW w(h);
+    for (std::size_t c = lo; c < hi; ++c) {
+      const auto [i, a] = candidates[c];
+      const Vec3& xi = dem_x[i];
+      const Vec3& xa = sph_x[a];
+      const double dx = xi.x() - xa.x(), dx2 = dx * dx;
+      if (dx2 >= rc2) continue;  // x is not periodic: cheap rejection first
+      const double dy = mi.wrap_y(xi.y() - xa.y()), dz = mi.wrap_z(xi.z() - xa.z());
+      const double r2 = dx2 + dy * dy + dz * dz;
+      if (r2 < rc2) mine.push_back({i, a, w(std::sqrt(r2))});
+      if (!ky && !kz) continue;
+      // Along a periodic axis of length l >= rc at most the next image on
+      // the other side, d - sign(d) l, is also closer than rc (|d| <= l/2),
+      // and only when l < 2 rc.
+      const double oy = ky ? dy - std::copysign(box.ly, dy) : 0.0, oz = kz ? dz - std::copysign(box.lz, dz) : 0.0;
+      const bool y2 = ky && oy * oy < rc2, z2 = kz && oz * oz < rc2;
+      auto image = [&](double ey, double ez) {
+        const double q2 = dx2 + ey * ey + ez * ez;
+        if (q2 < rc2) mine.push_back({i, a, w(std::sqrt(q2))});
+      };
+      if (y2) image(oy, dz);
+      if (z2) {
+        image(dy, oz);
+        if (y2) image(oy, oz);
+      }
+    }
+  }
+  for (int blk = 1; blk < blocks; ++blk) out.insert(out.end(), part[static_cast<std::size_t>(blk)].begin(),
+                                                     part[static_cast<std::size_t>(blk)].end());
+}
+
+void coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x, const Box& box, double h,
+                    std::vector<CouplingPair>& out) {
+  if (!(h > 0.0)) throw std::invalid_argument("coupling_pairs: smoothing length h must be > 0");
+  std::vector<IndexPair> candidates;
+  coupling_candidates(dem_x, sph_x, box, k_kernel_support * h, candidates);
+  coupling_pairs_of(candidates, dem_x, sph_x, box, h, out);
+}
+
+bool coupling_cache_stale(const CouplingPairCache& cache, const std::vector<Vec3>& dem_x,
+                          const std::vector<Vec3>& sph_x, const Box& box, double h) {
+  if (cache.builds == 0 || cache.dem_ref.size() != dem_x.size() || cache.sph_ref.size() != sph_x.size()) return true;
+  const double reach = k_kernel_support * h + cache.skin;
+  const double dn = max_nonaffine_displacement(dem_x, cache.dem_ref, box, cache.strain);
+  const double sn = max_nonaffine_displacement(sph_x, cache.sph_ref, box, cache.strain);
+  // the displacements are minimum-image differences: keep them far below
+  // half the box
+  const double quarter = 0.25 * std::min(box.ly, box.lz);
+  return skin_spent(dn + sn, cache.strain, reach, cache.skin) || max_displacement(dem_x, cache.dem_ref, box) > quarter ||
+         max_displacement(sph_x, cache.sph_ref, box) > quarter;
+}
+
+void rebuild_coupling_cache(CouplingPairCache& cache, const std::vector<Vec3>& dem_x,
+                            const std::vector<Vec3>& sph_x, const Box& box, double h) {
+  coupling_candidates(dem_x, sph_x, box, k_kernel_support * h + cache.skin, cache.candidates);
+  cache.dem_ref = dem_x;
+  cache.sph_ref = sph_x;
+  cache.strain = 0;
+  ++cache.builds;
 }
 
 std::vector<CouplingPair> coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x,

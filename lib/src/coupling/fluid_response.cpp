@@ -1,6 +1,7 @@
 #include "mrf/coupling/fluid_response.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 
 #include "mrf/neighbors/cell_list.hpp"
 
@@ -9,13 +10,12 @@ namespace mrf {
 void FluidResponse::set(std::size_t n_dem, const std::vector<CouplingPair>& pairs, const std::vector<double>& s,
                         const std::vector<double>& rho, double mass) {
   // Per DEM particle its SPH neighbours in the order of the pairs (pairs
-  // come sorted by DEM index), the periodic images of one neighbour merged
-  // (their weights add; slot_ finds an SPH particle's entry of the row).
+  // come sorted by DEM index, then SPH index, so the periodic images of one
+  // neighbour are adjacent: their weights add).
   const std::size_t na = rho.size();
-  slot_.assign(na, -1);
+  mass_ = mass;
   a_.clear();
   scatter_.clear();
-  gather_.clear();
   std::vector<std::uint32_t> merged(n_dem + 1, 0);
   std::size_t next = 0;
   for (std::size_t i = 0; i < n_dem; ++i) {
@@ -23,17 +23,14 @@ void FluidResponse::set(std::size_t n_dem, const std::vector<CouplingPair>& pair
     for (; next < pairs.size() && pairs[next].i == i; ++next) {
       const CouplingPair& q = pairs[next];
       const double sc = q.w / (rho[q.a] * s[i]);
-      if (slot_[q.a] >= 0) {
-        scatter_[static_cast<std::size_t>(slot_[q.a])] += sc;
-        gather_[static_cast<std::size_t>(slot_[q.a])] += mass * sc;
+      if (a_.size() > row && a_.back() == q.a) {
+        scatter_.back() += sc;
       } else {
-        slot_[q.a] = static_cast<std::int32_t>(a_.size());
+        if (a_.size() > row && a_.back() > q.a) throw std::logic_error("FluidResponse::set: pairs not sorted by (i, a)");
         a_.push_back(q.a);
         scatter_.push_back(sc);
-        gather_.push_back(mass * sc);
       }
     }
-    for (std::size_t k = row; k < a_.size(); ++k) slot_[a_[k]] = -1;
     merged[i + 1] = checked_index(a_.size(), "fluid response");
   }
   start_ = std::move(merged);
@@ -54,16 +51,17 @@ void FluidResponse::set(std::size_t n_dem, const std::vector<CouplingPair>& pair
     }
   diag_.assign(n_dem, 0.0);
   for (std::size_t i = 0; i < n_dem; ++i)
-    for (std::uint32_t e = start_[i]; e < start_[i + 1]; ++e) diag_[i] += gather_[e] * scatter_[e];
+    for (std::uint32_t e = start_[i]; e < start_[i + 1]; ++e) diag_[i] += mass * scatter_[e] * scatter_[e];
   z_.assign(3 * na, 0.0);
   dense_.assign(na, 0.0);
 }
 
 double FluidResponse::coupling(std::size_t i, std::size_t k) const {
   // i's gather weights spread over its SPH neighbours, read back by k's
-  for (std::uint32_t p = start_[i]; p < start_[i + 1]; ++p) dense_[a_[p]] = gather_[p];
+  for (std::uint32_t p = start_[i]; p < start_[i + 1]; ++p) dense_[a_[p]] = scatter_[p];
   double c = 0;
   for (std::uint32_t q = start_[k]; q < start_[k + 1]; ++q) c += dense_[a_[q]] * scatter_[q];
+  c *= mass_;
   for (std::uint32_t p = start_[i]; p < start_[i + 1]; ++p) dense_[a_[p]] = 0.0;
   return c;
 }
@@ -81,7 +79,8 @@ void FluidResponse::add(const std::vector<Vec3>& f, double scale, std::vector<Ve
   const std::uint32_t* a = a_.data();
   const std::uint32_t* rj = rdem_.data();
   const double* rs = rscatter_.data();
-  const double* ga = gather_.data();
+  const double* ga = scatter_.data();
+  const double gscale = scale * mass_;
   const Vec3* fv = f.data();
   const bool threads = a_.size() > k_entries_per_thread;
 #pragma omp parallel for schedule(static) if (threads)
@@ -106,9 +105,9 @@ void FluidResponse::add(const std::vector<Vec3>& f, double scale, std::vector<Ve
       sy += ga[e] * zy[b];
       sz += ga[e] * zz[b];
     }
-    y[i].x() += scale * sx;
-    y[i].y() += scale * sy;
-    y[i].z() += scale * sz;
+    y[i].x() += gscale * sx;
+    y[i].y() += gscale * sy;
+    y[i].z() += gscale * sz;
   }
 }
 

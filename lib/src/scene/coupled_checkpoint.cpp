@@ -16,7 +16,11 @@
 // fluid and wall pressures and wall densities, the DEM-SPH pairs (with the
 // wall mirror images), the SPH pair cache's candidates (found again from
 // its saved reference positions: the same sorted list) and the porosity
-// range of sums_. Not saved because
+// range of sums_. The coupling pair cache is saved by its reference
+// positions, wall-mirrored particles, build time and count, and its
+// candidates found again from the reference positions (the same sorted
+// list; the pairs would be the same without it, but not the rebuilds).
+// Not saved because
 // step() recomputes them before use: the Shepard fields, buoyancy, friction
 // coefficients and parcel state (prepare_coupling sets parcel u to the fluid
 // velocity and zeroes the impulse every fluid step), f_old_/f_new_ (set in
@@ -27,6 +31,7 @@
 #include "mrf/scene/coupled_model.hpp"
 
 #include "mrf/error.hpp"
+#include "mrf/fluid/kernel.hpp"
 #include "mrf/fluid/wcsph.hpp"
 #include "mrf/scene/dem_model.hpp"
 
@@ -51,6 +56,9 @@ void CoupledModel::load(ArchiveReader& in) {
   } else {
     refresh(fluid_);
   }
+  if (!coupling_cache_.dem_ref.empty())
+    coupling_candidates(coupling_cache_.dem_ref, coupling_cache_.sph_ref, cell_.box,
+                        k_kernel_support * fluid_.h + coupling_cache_.skin, coupling_cache_.candidates);
   update_coupling_pairs();
 }
 

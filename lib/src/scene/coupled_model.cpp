@@ -102,6 +102,7 @@ CoupledModel::CoupledModel(ShearCell cell, const DemParams& params, FluidCell fl
   double near_reach = 0;
   lists_ = dem_pair_lists(p_, cell_.box, inertialess, cell_.walls.size() > 0, near_reach);
   sph_pairs_.skin = stepping_.sph_skin;
+  coupling_cache_.skin = stepping_.coupling_skin;
   if (inertialess) {
     implicit_.emplace(stepping_.implicit, implicit_contact_params(p_), stepping_.dt_max, near_reach);
     overlap_limit_ = p_.radius;
@@ -144,6 +145,7 @@ void CoupledModel::finish(RunSummary& s) const {
   s.extra["momentum_drift_N_s"] = drift.norm();
   s.extra["momentum_drift_relative"] = scale > 0 ? drift.norm() / scale : 0.0;
   s.extra["sph_wall_reflections"] = static_cast<double>(sums_.wall_reflections);
+  s.extra["coupling_pair_builds"] = static_cast<double>(coupling_cache_.builds);
   if (implicit_) {
     report_implicit(implicit_->counters(), time_, steps_, s);
     s.extra["fluid_steps"] = static_cast<double>(fluid_substeps_);
@@ -169,12 +171,37 @@ void CoupledModel::update_coupling_pairs() {
   // falls and the tension pulls SPH particles through the wall (seen at
   // Mn = 1e-2 after 4.5 strain units). One search serves both lists: the
   // mirror images have indices >= n, and pairs come sorted by index.
+  // The pairs come from a Verlet cache (coupling/exchange.hpp) whose
+  // points are the particles and the mirrors of those within reach of a
+  // wall at its build; a mirror counts only while its particle is within
+  // 2h of the wall, so the pairs equal a fresh search's.
   const std::size_t n = cell_.free.size();
   const double rc = k_kernel_support * fluid_.h, half = 0.5 * cell_.box.gap;
-  solid_ = cell_.free.x;
-  for (const Vec3& x : cell_.free.x)
-    if (half - std::abs(x.x()) < rc) solid_.emplace_back((x.x() > 0 ? 2.0 * half : -2.0 * half) - x.x(), x.y(), x.z());
-  coupling_pairs(solid_, fluid_.fluid.x, cell_.box, fluid_.h, solid_pairs_);
+  const auto& x = cell_.free.x;
+  auto mirror = [&](const Vec3& p) { return Vec3((p.x() > 0 ? 2.0 * half : -2.0 * half) - p.x(), p.y(), p.z()); };
+  auto place = [&] {
+    solid_.assign(x.begin(), x.end());
+    for (std::uint32_t i : mirrored_) solid_.push_back(mirror(x[i]));
+  };
+  place();
+  coupling_cache_.strain = p_.shear_rate * (time_ - coupling_cache_time_);
+  if (coupling_cache_.skin <= 0 ||
+      coupling_cache_stale(coupling_cache_, solid_, fluid_.fluid.x, cell_.box, fluid_.h)) {
+    const double reach = rc + coupling_cache_.skin;
+    mirrored_.clear();
+    for (std::uint32_t i = 0; i < n; ++i)
+      if (half - std::abs(x[i].x()) < reach) mirrored_.push_back(i);
+    place();
+    rebuild_coupling_cache(coupling_cache_, solid_, fluid_.fluid.x, cell_.box, fluid_.h);
+    coupling_cache_time_ = time_;
+    coupling_cache_.strain = 0;
+  }
+  coupling_pairs_of(coupling_cache_.candidates, solid_, fluid_.fluid.x, cell_.box, fluid_.h, solid_pairs_);
+  solid_pairs_.erase(std::remove_if(solid_pairs_.begin(), solid_pairs_.end(),
+                                    [&](const CouplingPair& q) {
+                                      return q.i >= n && !(half - std::abs(x[mirrored_[q.i - n]].x()) < rc);
+                                    }),
+                     solid_pairs_.end());
   const auto real_end = std::partition_point(solid_pairs_.begin(), solid_pairs_.end(),
                                              [n](const CouplingPair& q) { return q.i < n; });
   pairs_.assign(solid_pairs_.begin(), real_end);

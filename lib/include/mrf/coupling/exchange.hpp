@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "mrf/box.hpp"
+#include "mrf/neighbors/cell_list.hpp"
 
 namespace mrf {
 
@@ -37,9 +38,43 @@ struct CouplingPair {
 std::vector<CouplingPair> coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x,
                                          const Box& box, double h);
 // Same, into `out` (cleared; its capacity is reused). Pairs come sorted by
-// DEM index i.
+// (DEM index i, SPH index a, image), so every sum over them has the same
+// order whether the pairs come from a fresh search or from candidates.
 void coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x, const Box& box, double h,
                     std::vector<CouplingPair>& out);
+
+// Verlet candidates: the (DEM i, SPH a) with a minimum-image distance below
+// `reach` (m), sorted by (i, a), into `out`.
+void coupling_candidates(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x, const Box& box,
+                         double reach, std::vector<IndexPair>& out);
+// The pairs closer than 2h among the candidates, in their order (each image
+// its own entry, as coupling_pairs): equal to coupling_pairs bit for bit
+// when every pair within 2h is a candidate.
+void coupling_pairs_of(const std::vector<IndexPair>& candidates, const std::vector<Vec3>& dem_x,
+                       const std::vector<Vec3>& sph_x, const Box& box, double h, std::vector<CouplingPair>& out);
+
+// Verlet cache of the coupling pairs between two moving point sets (the DEM
+// particles with their wall mirrors, the SPH fluid), rebuilt by the bound
+// of neighbors/verlet_list.hpp: max|n_dem| + max|n_sph| + |gamma| reach <=
+// skin (non-affine displacements n since the build, gamma the imposed
+// strain since the build; the caller adds gdot dt). The pairs do not depend
+// on when the candidates were built (coupling_pairs_of), so a checkpoint
+// need not hold the cache: a loaded run rebuilds it and finds the same pairs.
+struct CouplingPairCache {
+  double skin = 0;  // m; 0 = search every time
+  std::vector<IndexPair> candidates;
+  std::vector<Vec3> dem_ref, sph_ref;  // positions at the build
+  double strain = 0;
+  long builds = 0;
+};
+
+// True when the candidates may miss a pair within 2h (or were never built,
+// or the number of points changed).
+bool coupling_cache_stale(const CouplingPairCache& cache, const std::vector<Vec3>& dem_x,
+                          const std::vector<Vec3>& sph_x, const Box& box, double h);
+// Builds the candidates at the current positions.
+void rebuild_coupling_cache(CouplingPairCache& cache, const std::vector<Vec3>& dem_x,
+                            const std::vector<Vec3>& sph_x, const Box& box, double h);
 
 // Default porosity floor: eps below it (overlapping kernels of a dense packing)
 // would make the drag and eps-weighted densities blow up; 0.2 is well below

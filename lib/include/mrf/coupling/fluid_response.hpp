@@ -23,7 +23,8 @@ namespace mrf {
 
 class FluidResponse final : public MobilityCoupling {
  public:
-  // pairs sorted by DEM index (coupling_pairs), the Shepard sums s_i, the
+  // pairs sorted by DEM index, then SPH index (coupling_pairs; throws
+  // std::logic_error otherwise), the Shepard sums s_i, the
   // density rho_a that divides the SPH sums and the SPH particle mass (kg).
   void set(std::size_t n_dem, const std::vector<CouplingPair>& pairs, const std::vector<double>& s,
            const std::vector<double>& rho, double mass);
@@ -36,11 +37,13 @@ class FluidResponse final : public MobilityCoupling {
   double coupling(std::size_t i, std::size_t k) const override;
 
  private:
-  // Per DEM particle, per SPH neighbour (images merged): SPH index,
-  // scatter weight W / (rho_a s_j) and gather weight m W / (rho_a s_i), so
-  // that an application is two passes of three multiply-adds per entry.
+  // Per DEM particle, per SPH neighbour (images merged): SPH index and
+  // weight W / (rho_a s_j), which scatters a force and, times m, gathers
+  // the response, so that an application is two passes of three
+  // multiply-adds per entry.
   std::vector<std::uint32_t> a_;
-  std::vector<double> scatter_, gather_;
+  std::vector<double> scatter_;
+  double mass_ = 0;
   std::vector<std::uint32_t> start_;  // pairs of DEM particle i: [start_[i], start_[i + 1])
   std::vector<std::uint32_t> rstart_, rdem_;  // the entries by SPH particle: DEM index
   std::vector<double> rscatter_;              // and scatter weight
@@ -49,7 +52,6 @@ class FluidResponse final : public MobilityCoupling {
   static constexpr std::size_t k_entries_per_thread = 20000;
   std::vector<double> diag_;
   std::vector<double> z_;             // per SPH particle, by component: sum_j W_aj f_j / (rho_a s_j)
-  std::vector<std::int32_t> slot_;    // scratch of set(): SPH particle -> entry of the current row
   mutable std::vector<double> dense_; // scratch of coupling(): per SPH particle, zero between calls
 };
 

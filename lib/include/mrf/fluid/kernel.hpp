@@ -20,13 +20,21 @@ inline constexpr double k_kernel_support = 2.0;
 
 inline double kernel_alpha(double h) { return 21.0 / (16.0 * k_pi * h * h * h); }
 
+// W(r) of one smoothing length h with alpha computed once: what loops over
+// many pairs call; kernel_w below is the same law, bit for bit.
+struct KernelW {
+  double h, alpha;
+  explicit KernelW(double h_) : h(h_), alpha(kernel_alpha(h_)) {}
+  double operator()(double r) const {
+    const double q = r / h;
+    if (q >= k_kernel_support) return 0.0;
+    const double t = 1.0 - 0.5 * q;
+    return alpha * t * t * t * t * (2.0 * q + 1.0);
+  }
+};
+
 // W(r, h) in 1/m^3; zero for r >= 2h.
-inline double kernel_w(double r, double h) {
-  const double q = r / h;
-  if (q >= k_kernel_support) return 0.0;
-  const double t = 1.0 - 0.5 * q;
-  return kernel_alpha(h) * t * t * t * t * (2.0 * q + 1.0);
-}
+inline double kernel_w(double r, double h) { return KernelW(h)(r); }
 
 // (dW/dr)/r in 1/m^5: finite at r = 0, the factor that multiplies r_ab in
 // the gradient and in the Morris viscous term.

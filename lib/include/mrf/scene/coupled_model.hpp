@@ -68,6 +68,7 @@ struct CoupledStepping {
   // then the CFL bound; pressure and viscosity: the advective bound)
   SphImplicit sph = SphImplicit::none;
   double sph_skin = 0;    // inertialess: Verlet skin of the SPH pairs (m; 0 = search every sub-step)
+  double coupling_skin = 0;  // Verlet skin of the DEM-SPH coupling pairs (m; 0 = search every step)
   ImplicitOptions implicit;  // inertialess
 };
 
@@ -156,7 +157,8 @@ class CoupledModel final : public Model {
     serialize_dem_state(ar, m.cell_, m.lists_);
     ar.io(m.fluid_.fluid.x, m.fluid_.fluid.v, m.fluid_.fluid.a_ext, m.fluid_.fluid.rest_density, m.fluid_.wall.x,
           m.fluid_.wall.v, m.sums_.wall_reflections, m.external_impulse_, m.time_, m.steps_, m.eps_seen_min_,
-          m.eps_seen_max_, m.clamped_steps_);
+          m.eps_seen_max_, m.clamped_steps_, m.coupling_cache_.dem_ref, m.coupling_cache_.sph_ref,
+          m.coupling_cache_.builds, m.mirrored_, m.coupling_cache_time_);
     if (m.implicit_) ar.io(*m.implicit_, m.fluid_substeps_, m.sph_pairs_, m.viscous_iterations_);
   }
   void update_coupling_pairs();
@@ -182,6 +184,9 @@ class CoupledModel final : public Model {
   ForceBuffers buffers_;
   std::vector<CouplingPair> pairs_, solid_pairs_;  // real particles; with wall mirror images
   std::vector<Vec3> solid_;
+  CouplingPairCache coupling_cache_;
+  std::vector<std::uint32_t> mirrored_;  // the particles whose wall mirrors the cache holds
+  double coupling_cache_time_ = 0;       // of its build
   ShepardField shepard_;
   std::vector<Vec3> u_at_, buoyancy_, f_old_, f_new_;
   std::vector<double> eps_at_;
