@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "mrf/integrate/contact_dual.hpp"
 #include "mrf/integrate/stability.hpp"
 #include "mrf/io/toml_scene.hpp"
 #include "mrf/scene/dem_model.hpp"
@@ -119,6 +120,41 @@ TEST(ContactDual, TwoStageCandidateSearchEqualsTheFullSearch) {
     EXPECT_EQ(full[n].wall, staged[n].wall);
   }
   EXPECT_LT(near.size(), m.lists().ff.k.size() / 2) << "the near list should be much shorter than the dipole list";
+}
+
+// The incomplete-Cholesky preconditioner of the dual CG (ContactDual::
+// Preconditioner): on the small scene at the real modulus of iron (chains,
+// branches and loops of contacts), fixed steps solved at a tight tolerance
+// give the same trajectory with IC(0) as with Jacobi, in far fewer CG
+// iterations. (The coupled models use it by default: there a product
+// sweeps every DEM-SPH pair.)
+TEST(ContactDual, IncompleteCholeskyGivesTheJacobiTrajectoryInFewerIterations) {
+  const Small s = small();
+  const double dt = 9.0 * smallest(dem_limits(s.p, s.config.gap, IntegratorId::verlet_exp));
+  auto model = [&](ContactDual::Preconditioner p) {
+    DemModel m(build_shear_cell(s.config), s.p, IntegratorId::implicit, dt);
+    ImplicitOptions o;
+    o.fixed_step = true;
+    o.newton_tol_over_radius = 1e-11;
+    o.linear_rtol = 1e-12;
+    o.max_newton = 200;
+    o.dual_preconditioner = p;
+    m.set_implicit_options(o);
+    return m;
+  };
+  DemModel ic = model(ContactDual::Preconditioner::incomplete_cholesky);
+  DemModel jac = model(ContactDual::Preconditioner::jacobi);
+  for (int n = 0; n < 100; ++n) {
+    ASSERT_NO_THROW(ic.step()) << "IC(0), step " << n;
+    ASSERT_NO_THROW(jac.step()) << "Jacobi, step " << n;
+  }
+  const double diff = max_distance_over_radius(ic, jac);
+  const long cg_ic = ic.implicit_counters().linear_iterations, cg_j = jac.implicit_counters().linear_iterations;
+  std::printf("100 steps of %.2e s: IC(0) - Jacobi %.2e R; CG iterations %ld vs %ld (Newton %ld vs %ld)\n", dt, diff,
+              cg_ic, cg_j, ic.implicit_counters().newton_iterations, jac.implicit_counters().newton_iterations);
+  EXPECT_GT(ic.sums().max_overlap, 0.0) << "the steps must make contacts";
+  EXPECT_LT(diff, 1e-8);
+  EXPECT_LT(2 * cg_ic, cg_j) << "IC(0) must at least halve the CG iterations";
 }
 
 }  // namespace

@@ -83,14 +83,114 @@ long ContactDual::solve_cg(const std::vector<ContactPair>& pairs, double rtol) {
     diag_[a] = mob[c.i] + (c.wall ? 0.0 : mob[c.k]) + comp_[act_[a]] + (coupled_ ? crel_[act_[a]] : 0.0);
     r_[a] = rhs_[act_[a]];
   }
+  auto apply_a = [&](const std::vector<double>& p, std::vector<double>& out) { apply(pairs, p, out); };
+  const bool ic0 = precond_ == Preconditioner::incomplete_cholesky ||
+                   (precond_ == Preconditioner::automatic && coupled_ != nullptr);
+  if (ic0 && factor_ic0(pairs))
+    return pcg(
+        r_, rtol, 10 * static_cast<long>(m) + 10, apply_a,
+        [&](const std::vector<double>& r, std::vector<double>& z) { apply_ic0(r, z); }, d_, cg_);
   return pcg(
-      r_, rtol, 10 * static_cast<long>(m) + 10,
-      [&](const std::vector<double>& p, std::vector<double>& out) { apply(pairs, p, out); },
+      r_, rtol, 10 * static_cast<long>(m) + 10, apply_a,
       [&](const std::vector<double>& r, std::vector<double>& z) {
         z.resize(r.size());
         for (std::size_t a = 0; a < r.size(); ++a) z[a] = r[a] / diag_[a];
       },
       d_, cg_);
+}
+
+bool ContactDual::factor_ic0(const std::vector<ContactPair>& pairs) {
+  const std::vector<double>& mob = *mob_;
+  const std::size_t m = act_.size(), n = disp_.size();
+  // the active contacts of each sphere
+  sph_start_.assign(n + 1, 0);
+  for (std::size_t a = 0; a < m; ++a) {
+    const ContactPair& c = pairs[act_[a]];
+    ++sph_start_[c.i + 1];
+    if (!c.wall) ++sph_start_[c.k + 1];
+  }
+  for (std::size_t i = 0; i < n; ++i) sph_start_[i + 1] += sph_start_[i];
+  sph_act_.resize(sph_start_[n]);
+  {
+    std::vector<std::uint32_t>& fill = l_start_;  // scratch
+    fill.assign(sph_start_.begin(), sph_start_.end() - 1);
+    for (std::size_t a = 0; a < m; ++a) {
+      const ContactPair& c = pairs[act_[a]];
+      sph_act_[fill[c.i]++] = static_cast<std::uint32_t>(a);
+      if (!c.wall) sph_act_[fill[c.k]++] = static_cast<std::uint32_t>(a);
+    }
+  }
+  // Row a of A below the diagonal: b < a sharing a sphere p, entry
+  // s_a s_b mob_p n_a . n_b (s = +1 on i, -1 on k). Two contacts share at
+  // most one sphere, so no entry is found twice; rows come out ascending
+  // because each sphere's list is.
+  l_start_.assign(m + 1, 0);
+  l_col_.clear();
+  l_val_.clear();
+  std::vector<std::pair<std::uint32_t, double>> row;
+  for (std::size_t a = 0; a < m; ++a) {
+    const ContactPair& c = pairs[act_[a]];
+    const Vec3& na = n_[act_[a]];
+    row.clear();
+    for (int end = 0; end < (c.wall ? 1 : 2); ++end) {
+      const std::uint32_t p = end == 0 ? c.i : c.k;
+      const double sa = end == 0 ? 1.0 : -1.0;
+      for (std::uint32_t e = sph_start_[p]; e < sph_start_[p + 1]; ++e) {
+        const std::uint32_t b = sph_act_[e];
+        if (b >= a) break;
+        const ContactPair& cb = pairs[act_[b]];
+        const double sb = cb.i == p ? 1.0 : -1.0;
+        row.emplace_back(b, sa * sb * mob[p] * na.dot(n_[act_[b]]));
+      }
+    }
+    std::sort(row.begin(), row.end());
+    for (const auto& [b, v] : row) {
+      l_col_.push_back(b);
+      l_val_.push_back(v);
+    }
+    l_start_[a + 1] = static_cast<std::uint32_t>(l_col_.size());
+  }
+  // IC(0) by rows: L_ab = (A_ab - sum_{j < b} L_aj L_bj) / L_bb over the
+  // pattern of A, L_aa = sqrt(A_aa - sum_b L_ab^2).
+  l_diag_.resize(m);
+  for (std::size_t a = 0; a < m; ++a) {
+    double d = diag_[a];
+    for (std::uint32_t e = l_start_[a]; e < l_start_[a + 1]; ++e) {
+      const std::uint32_t b = l_col_[e];
+      double v = l_val_[e];
+      // the dot product of row a (entries before e) with row b
+      std::uint32_t p = l_start_[a], q = l_start_[b];
+      while (p < e && q < l_start_[b + 1]) {
+        if (l_col_[p] < l_col_[q]) {
+          ++p;
+        } else if (l_col_[q] < l_col_[p]) {
+          ++q;
+        } else {
+          v -= l_val_[p++] * l_val_[q++];
+        }
+      }
+      l_val_[e] = v / l_diag_[b];
+      d -= l_val_[e] * l_val_[e];
+    }
+    if (!(d > 1e-12 * diag_[a])) return false;
+    l_diag_[a] = std::sqrt(d);
+  }
+  return true;
+}
+
+void ContactDual::apply_ic0(const std::vector<double>& r, std::vector<double>& z) const {
+  const std::size_t m = r.size();
+  ic_y_.resize(m);
+  for (std::size_t a = 0; a < m; ++a) {  // L y = r
+    double v = r[a];
+    for (std::uint32_t e = l_start_[a]; e < l_start_[a + 1]; ++e) v -= l_val_[e] * ic_y_[l_col_[e]];
+    ic_y_[a] = v / l_diag_[a];
+  }
+  z.resize(m);
+  for (std::size_t a = m; a-- > 0;) {  // L^T z = y, by columns of L^T (rows of L)
+    z[a] = ic_y_[a] / l_diag_[a];
+    for (std::uint32_t e = l_start_[a]; e < l_start_[a + 1]; ++e) ic_y_[l_col_[e]] -= l_val_[e] * z[a];
+  }
 }
 
 NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& b,
@@ -109,9 +209,9 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
   n_.resize(np);
   comp_.resize(np);
   rhs_.resize(np);
-  s_.resize(y.size());
-  disp_.resize(y.size());
-  seen_.assign(y.size(), 0);
+  s_.resize(b.size());
+  disp_.resize(b.size());
+  seen_.assign(b.size(), 0);
   std::uint32_t stamp = 1;
   if (coupled_) {  // s (C_ii + C_kk - 2 C_ik) of each candidate: the diagonal of s G^T C G (Jacobi)
     crel_.resize(np);

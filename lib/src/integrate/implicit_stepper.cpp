@@ -79,6 +79,7 @@ ImplicitStepper::Attempt ImplicitStepper::attempt(double dt, const ImplicitDrift
   Attempt a;
   if (opt_.formulation == ContactFormulation::dual) {
     // Starts from the contact forces at x_n (walls at t_n).
+    dual_.set_preconditioner(opt_.dual_preconditioner);
     a.newton = dual_.solve(candidates_, b_, x0_, walls0_, walls, box, p_.radius, p_.hertz_k, mob_, d.coupling,
                            c * dt * dt, nopt, f.x);
   } else {

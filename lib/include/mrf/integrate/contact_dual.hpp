@@ -46,6 +46,13 @@ class ContactDual {
   // k) to f: pairwise opposite, so their sum over the free particles is the
   // walls' push alone, whatever the Newton tolerance.
   void add_forces(const std::vector<ContactPair>& pairs, std::vector<Vec3>& f) const;
+  // The CG preconditioner. automatic: incomplete Cholesky where a product
+  // is dear (a coupled mobility, whose product sweeps every DEM-SPH pair:
+  // it halves the CG iterations of the coupled models), Jacobi otherwise
+  // (model 1's product is cheaper than the factorisation; measured,
+  // docs/performance.md).
+  enum class Preconditioner { automatic, jacobi, incomplete_cholesky };
+  void set_preconditioner(Preconditioner p) { precond_ = p; }
 
  private:
   // y += M G q for the pair values q (all pairs, or the active set)
@@ -54,6 +61,14 @@ class ContactDual {
   // (A + C) p on the active set
   void apply(const std::vector<ContactPair>& pairs, const std::vector<double>& p, std::vector<double>& out);
   long solve_cg(const std::vector<ContactPair>& pairs, double rtol);
+  // Incomplete Cholesky IC(0) of the assembled A + C on the active set
+  // (the coupled part by its diagonal only), the CG preconditioner: A
+  // couples two contacts only through a sphere they share, so its graph is
+  // the line graph of the contact network, and along chains (a tree of
+  // contacts: cliques joined at spheres) IC(0) is close to the exact
+  // factor. False (and Jacobi is used) when a pivot is not positive.
+  bool factor_ic0(const std::vector<ContactPair>& pairs);
+  void apply_ic0(const std::vector<double>& r, std::vector<double>& z) const;
 
   // Per candidate pair: force (N), compliance slope (m/N), Newton
   // right-hand side (m), unit normal (k to i; frozen over a linear solve).
@@ -64,10 +79,16 @@ class ContactDual {
   std::vector<std::uint32_t> seen_;           // per sphere: the iteration that listed it in act_particles_
   std::vector<double> d_, r_, diag_, dq_;           // CG on the active set: solution, right-hand side, Jacobi diagonal
   PcgScratch<double> cg_;
+  // IC(0): the strictly lower part of L by rows (columns ascending) and its
+  // diagonal; per sphere its active contacts (CSR over the spheres).
+  std::vector<std::uint32_t> l_start_, l_col_, sph_start_, sph_act_;
+  std::vector<double> l_val_, l_diag_;
+  mutable std::vector<double> ic_y_;
   std::vector<Vec3> s_, y_next_, disp_;      // per particle: G q, positions with the new normals, M G q
   const std::vector<double>* mob_ = nullptr;  // of the current solve
   MobilityCoupling* coupled_ = nullptr;
   double coupled_scale_ = 0;
+  Preconditioner precond_ = Preconditioner::automatic;
 };
 
 }  // namespace mrf

@@ -56,6 +56,7 @@ struct ImplicitOptions {
   bool fixed_step = false;               // every step = the dt given (convergence tests); no error control
   ContactFormulation formulation = ContactFormulation::dual;
   ContactLinearSolver solver = ContactLinearSolver::pcg;  // primal only
+  ContactDual::Preconditioner dual_preconditioner = ContactDual::Preconditioner::automatic;  // dual only
 };
 
 // Work of the implicit scheme since construction.
