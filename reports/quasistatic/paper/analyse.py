@@ -8,6 +8,9 @@ Usage: /usr/bin/python3 reports/quasistatic/paper/analyse.py NAME=RUN_DIR[:FROM[
   --label: what the run's summary.json does not say (e.g. its Young's modulus),
   put first in its note; the increment, tolerance, cut-off and seed come from
   summary.json, and a lock on a short repeat (deviation < 1 %) is noted.
+  RUN_DIR may also be a committed per-minimum CSV (e.g. headline_quasistatic.csv
+  beside this script): a finished run, its settings then given by --label and
+  its stress scale by --scale or another run.
   The first run is the headline. RUN_DIR holds quasistatic.csv and summary.json
   of `mrf quasistatic` (a run still going has a partial CSV and no summary: its
   stress scale is then taken from the headline's, or from --scale). FROM/TO:
@@ -98,9 +101,11 @@ def main(argv):
         name, rest = spec.split("=", 1)
         parts = rest.split(":")
         d = parts[0]
-        rows = list(csv.DictReader(open(os.path.join(d, "quasistatic.csv"))))
+        committed = d.endswith(".csv")  # a finished run's per-minimum CSV, as committed beside this script
+        csv_path = d if committed else os.path.join(d, "quasistatic.csv")
+        rows = list(csv.DictReader(open(csv_path)))
         summ = os.path.join(d, "summary.json")
-        s = json.load(open(summ)) if os.path.exists(summ) else {}
+        s = {} if committed or not os.path.exists(summ) else json.load(open(summ))
         strain = [float(r["strain"]) for r in rows]
         wall = [float(r["stress_wall"]) for r in rows]
         frm = float(parts[1]) if len(parts) > 1 else s.get("steady_from_strain", 0.2)
@@ -110,7 +115,8 @@ def main(argv):
             scale = scale or s["stress_scale"]
         runs.append(dict(name=name, dir=d, strain=strain, wall=wall, frm=frm, to=to, n=len(win),
                          mean=sum(win) / len(win) if win else float("nan"), err=block_error(win),
-                         dev=periodic(strain, wall, frm), rep=shortest_repeat(strain, wall), done=bool(s), summary=s, scale=s.get("stress_scale"),
+                         dev=periodic(strain, wall, frm), rep=shortest_repeat(strain, wall), done=bool(s) or committed,
+                         summary=s, scale=s.get("stress_scale"), csv=csv_path,
                          iters=sum(int(r["iterations"]) for r in rows), seconds=s.get("wall_seconds")))
     if scale is None:
         raise SystemExit("no summary.json among the runs: no stress scale (phi mu0 M^2)")
@@ -142,7 +148,9 @@ def main(argv):
                         r["rep"][0] if r["rep"] else "", f"{r['rep'][1]:.2e}" if r["rep"] else "", int(r["done"]),
                         note])
     head = runs[0]
-    shutil.copy(os.path.join(head["dir"], "quasistatic.csv"), os.path.join(here, f"{head['name']}_quasistatic.csv"))
+    target = os.path.join(here, f"{head['name']}_quasistatic.csv")
+    if os.path.abspath(head["csv"]) != os.path.abspath(target):
+        shutil.copy(head["csv"], target)
 
     fig, ax = plt.subplots(figsize=(10, 4.5))
     for i, r in enumerate(runs):
