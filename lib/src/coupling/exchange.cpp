@@ -19,6 +19,25 @@ namespace {
 constexpr std::size_t k_coupling_rows_per_thread = 1000;
 // candidates per thread below which their evaluation stays serial
 constexpr std::size_t k_coupling_candidates_per_thread = 50000;
+
+// body(lo, hi, mine) over [0, n) in contiguous blocks, one per thread when
+// n >= per_thread, each filling its own list; the lists are joined into
+// `out` in block order, so the result is the same whatever the number of
+// threads.
+template <class T, class Body>
+void in_blocks(std::size_t n, std::size_t per_thread, std::vector<T>& out, Body&& body) {
+  const int blocks = n >= per_thread ? std::max(1, omp_get_max_threads()) : 1;
+  std::vector<std::vector<T>> part(static_cast<std::size_t>(blocks));
+#pragma omp parallel for schedule(static, 1) if (blocks > 1)
+  for (int blk = 0; blk < blocks; ++blk) {
+    std::vector<T>& mine = blk == 0 ? out : part[static_cast<std::size_t>(blk)];
+    mine.clear();
+    body(n * static_cast<std::size_t>(blk) / static_cast<std::size_t>(blocks),
+         n * static_cast<std::size_t>(blk + 1) / static_cast<std::size_t>(blocks), mine);
+  }
+  for (int blk = 1; blk < blocks; ++blk)
+    out.insert(out.end(), part[static_cast<std::size_t>(blk)].begin(), part[static_cast<std::size_t>(blk)].end());
+}
 }  // namespace
 
 void coupling_candidates(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x, const Box& box,
@@ -37,33 +56,23 @@ void coupling_candidates(const std::vector<Vec3>& dem_x, const std::vector<Vec3>
   CellGrid grid(box, x_lo - reach, x_hi + reach, reach);
   grid.bin(sph_x);
   const MinImageYZ mi(box);
-  // DEM particles in contiguous blocks, one per thread, each filling its
-  // own list; the lists are joined in block order, so the candidates come
-  // in the same order whatever the number of threads.
-  const std::size_t n = dem_x.size();
-  const int blocks = n >= k_coupling_rows_per_thread ? std::max(1, omp_get_max_threads()) : 1;
-  std::vector<std::vector<IndexPair>> part(static_cast<std::size_t>(blocks));
-#pragma omp parallel for schedule(static, 1) if (blocks > 1)
-  for (int blk = 0; blk < blocks; ++blk) {
-    std::vector<IndexPair>& mine = blk == 0 ? out : part[static_cast<std::size_t>(blk)];
-    mine.clear();
-    const std::size_t lo = n * static_cast<std::size_t>(blk) / static_cast<std::size_t>(blocks);
-    const std::size_t hi = n * static_cast<std::size_t>(blk + 1) / static_cast<std::size_t>(blocks);
-    for (std::size_t ii = lo; ii < hi; ++ii) {
-      const auto i = static_cast<std::uint32_t>(ii);
-      const Vec3 xi = dem_x[i];
-      const std::size_t row = mine.size();
-      grid.for_each_candidate(xi, [&](std::uint32_t a) {
-        const Vec3& xa = sph_x[a];
-        const double dx = xi.x() - xa.x();
-        const double dy = mi.wrap_y(xi.y() - xa.y()), dz = mi.wrap_z(xi.z() - xa.z());
-        if (dx * dx + dy * dy + dz * dz < rc2) mine.emplace_back(i, a);
-      });
-      std::sort(mine.begin() + static_cast<std::ptrdiff_t>(row), mine.end());
-    }
-  }
-  for (int blk = 1; blk < blocks; ++blk) out.insert(out.end(), part[static_cast<std::size_t>(blk)].begin(),
-                                                     part[static_cast<std::size_t>(blk)].end());
+  // DEM particles in blocks (in_blocks): the candidates come in the same
+  // order whatever the number of threads.
+  in_blocks(dem_x.size(), k_coupling_rows_per_thread, out,
+            [&](std::size_t lo, std::size_t hi, std::vector<IndexPair>& mine) {
+              for (std::size_t ii = lo; ii < hi; ++ii) {
+                const auto i = static_cast<std::uint32_t>(ii);
+                const Vec3 xi = dem_x[i];
+                const std::size_t row = mine.size();
+                grid.for_each_candidate(xi, [&](std::uint32_t a) {
+                  const Vec3& xa = sph_x[a];
+                  const double dx = xi.x() - xa.x();
+                  const double dy = mi.wrap_y(xi.y() - xa.y()), dz = mi.wrap_z(xi.z() - xa.z());
+                  if (dx * dx + dy * dy + dz * dz < rc2) mine.emplace_back(i, a);
+                });
+                std::sort(mine.begin() + static_cast<std::ptrdiff_t>(row), mine.end());
+              }
+            });
 }
 
 void coupling_pairs_of(const std::vector<IndexPair>& candidates, const std::vector<Vec3>& dem_x,
@@ -78,51 +87,42 @@ void coupling_pairs_of(const std::vector<IndexPair>& candidates, const std::vect
                                 std::to_string(box.ly) + " m, lz " + std::to_string(box.lz) + " m, 2h " +
                                 std::to_string(rc) + " m): a pair would interact through more than two images");
   const MinImageYZ mi(box);
-  // contiguous blocks of candidates, one per thread, joined in block order
-  const std::size_t m = candidates.size();
-  const int blocks = m >= k_coupling_candidates_per_thread ? std::max(1, omp_get_max_threads()) : 1;
-  std::vector<std::vector<CouplingPair>> part(static_cast<std::size_t>(blocks));
-#pragma omp parallel for schedule(static, 1) if (blocks > 1)
-  for (int blk = 0; blk < blocks; ++blk) {
-    std::vector<CouplingPair>& mine = blk == 0 ? out : part[static_cast<std::size_t>(blk)];
-    mine.clear();
-    const std::size_t lo = m * static_cast<std::size_t>(blk) / static_cast<std::size_t>(blocks);
-    const std::size_t hi = m * static_cast<std::size_t>(blk + 1) / static_cast<std::size_t>(blocks);
-    mine.reserve(hi - lo);
-    const KernelW w(h);
-    for (std::size_t c = lo; c < hi; ++c) {
-      const auto [i, a] = candidates[c];
-      const Vec3& xi = dem_x[i];
-      const Vec3& xa = sph_x[a];
-      const double dx = xi.x() - xa.x(), dx2 = dx * dx;
-      if (dx2 >= rc2) continue;  // x is not periodic: cheap rejection first
-      const double dy = mi.wrap_y(xi.y() - xa.y()), dz = mi.wrap_z(xi.z() - xa.z());
-      const double r2 = dx2 + dy * dy + dz * dz;
-      if (r2 < rc2) mine.push_back({i, a, w(std::sqrt(r2))});
-      if (!ky && !kz) continue;
-      // Along a periodic axis of length l >= rc at most the next image on
-      // the other side, d - sign(d) l, is also closer than rc (|d| <= l/2),
-      // and only when l < 2 rc.
-      const double oy = ky ? dy - std::copysign(box.ly, dy) : 0.0, oz = kz ? dz - std::copysign(box.lz, dz) : 0.0;
-      const bool y2 = ky && oy * oy < rc2, z2 = kz && oz * oz < rc2;
-      auto image = [&](double ey, double ez) {
-        const double q2 = dx2 + ey * ey + ez * ez;
-        if (q2 < rc2) mine.push_back({i, a, w(std::sqrt(q2))});
-      };
-      if (y2) image(oy, dz);
-      if (z2) {
-        image(dy, oz);
-        if (y2) image(oy, oz);
-      }
-    }
-  }
-  for (int blk = 1; blk < blocks; ++blk) out.insert(out.end(), part[static_cast<std::size_t>(blk)].begin(),
-                                                     part[static_cast<std::size_t>(blk)].end());
+  // candidates in blocks (in_blocks), the pairs in candidate order
+  in_blocks(candidates.size(), k_coupling_candidates_per_thread, out,
+            [&](std::size_t lo, std::size_t hi, std::vector<CouplingPair>& mine) {
+              mine.reserve(hi - lo);
+              const KernelW w(h);
+              for (std::size_t c = lo; c < hi; ++c) {
+                const auto [i, a] = candidates[c];
+                const Vec3& xi = dem_x[i];
+                const Vec3& xa = sph_x[a];
+                const double dx = xi.x() - xa.x(), dx2 = dx * dx;
+                if (dx2 >= rc2) continue;  // x is not periodic: cheap rejection first
+                const double dy = mi.wrap_y(xi.y() - xa.y()), dz = mi.wrap_z(xi.z() - xa.z());
+                const double r2 = dx2 + dy * dy + dz * dz;
+                if (r2 < rc2) mine.push_back({i, a, w(std::sqrt(r2))});
+                if (!ky && !kz) continue;
+                // Along a periodic axis of length l >= rc at most the next image on
+                // the other side, d - sign(d) l, is also closer than rc (|d| <= l/2),
+                // and only when l < 2 rc.
+                const double oy = ky ? dy - std::copysign(box.ly, dy) : 0.0, oz = kz ? dz - std::copysign(box.lz, dz) : 0.0;
+                const bool y2 = ky && oy * oy < rc2, z2 = kz && oz * oz < rc2;
+                auto image = [&](double ey, double ez) {
+                  const double q2 = dx2 + ey * ey + ez * ez;
+                  if (q2 < rc2) mine.push_back({i, a, w(std::sqrt(q2))});
+                };
+                if (y2) image(oy, dz);
+                if (z2) {
+                  image(dy, oz);
+                  if (y2) image(oy, oz);
+                }
+              }
+            });
 }
 
 void coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x, const Box& box, double h,
                     std::vector<CouplingPair>& out) {
-  if (!(h > 0.0)) throw std::invalid_argument("coupling_pairs: smoothing length h must be > 0");
+  if (!(h > 0.0)) throw std::invalid_argument("coupling_pairs: smoothing length h must be > 0");  // named as h, not as the reach
   std::vector<IndexPair> candidates;
   coupling_candidates(dem_x, sph_x, box, k_kernel_support * h, candidates);
   coupling_pairs_of(candidates, dem_x, sph_x, box, h, out);

@@ -127,7 +127,7 @@ bool ContactDual::factor_ic0(const std::vector<ContactPair>& pairs) {
   l_start_.assign(m + 1, 0);
   l_col_.clear();
   l_val_.clear();
-  std::vector<std::pair<std::uint32_t, double>> row;
+  std::vector<std::pair<std::uint32_t, double>>& row = ic_row_;
   for (std::size_t a = 0; a < m; ++a) {
     const ContactPair& c = pairs[act_[a]];
     const Vec3& na = n_[act_[a]];

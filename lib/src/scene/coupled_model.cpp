@@ -194,7 +194,6 @@ void CoupledModel::update_coupling_pairs() {
     place();
     rebuild_coupling_cache(coupling_cache_, solid_, fluid_.fluid.x, cell_.box, fluid_.h);
     coupling_cache_time_ = time_;
-    coupling_cache_.strain = 0;
   }
   coupling_pairs_of(coupling_cache_.candidates, solid_, fluid_.fluid.x, cell_.box, fluid_.h, solid_pairs_);
   solid_pairs_.erase(std::remove_if(solid_pairs_.begin(), solid_pairs_.end(),

@@ -21,6 +21,7 @@
 // Open contacts are handled by projection (lambda >= 0) with an active set.
 #pragma once
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "mrf/box.hpp"
@@ -84,6 +85,7 @@ class ContactDual {
   std::vector<std::uint32_t> l_start_, l_col_, sph_start_, sph_act_;
   std::vector<double> l_val_, l_diag_;
   mutable std::vector<double> ic_y_;
+  std::vector<std::pair<std::uint32_t, double>> ic_row_;  // scratch: one row of A while it is assembled
   std::vector<Vec3> s_, y_next_, disp_;      // per particle: G q, positions with the new normals, M G q
   const std::vector<double>* mob_ = nullptr;  // of the current solve
   MobilityCoupling* coupled_ = nullptr;
