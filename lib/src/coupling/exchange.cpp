@@ -98,9 +98,13 @@ void coupling_pairs_of(const std::vector<IndexPair>& candidates, const std::vect
                 const Vec3& xa = sph_x[a];
                 const double dx = xi.x() - xa.x(), dx2 = dx * dx;
                 if (dx2 >= rc2) continue;  // x is not periodic: cheap rejection first
+                auto push = [&, i = i, a = a](double ey, double ez, double q2) {
+                  const double r = std::sqrt(q2);
+                  mine.push_back({i, a, w(r), kernel_dwdr_over_r(r, h) * Vec3(dx, ey, ez)});
+                };
                 const double dy = mi.wrap_y(xi.y() - xa.y()), dz = mi.wrap_z(xi.z() - xa.z());
                 const double r2 = dx2 + dy * dy + dz * dz;
-                if (r2 < rc2) mine.push_back({i, a, w(std::sqrt(r2))});
+                if (r2 < rc2) push(dy, dz, r2);
                 if (!ky && !kz) continue;
                 // Along a periodic axis of length l >= rc at most the next image on
                 // the other side, d - sign(d) l, is also closer than rc (|d| <= l/2),
@@ -109,7 +113,7 @@ void coupling_pairs_of(const std::vector<IndexPair>& candidates, const std::vect
                 const bool y2 = ky && oy * oy < rc2, z2 = kz && oz * oz < rc2;
                 auto image = [&](double ey, double ez) {
                   const double q2 = dx2 + ey * ey + ez * ez;
-                  if (q2 < rc2) mine.push_back({i, a, w(std::sqrt(q2))});
+                  if (q2 < rc2) push(ey, ez, q2);
                 };
                 if (y2) image(oy, dz);
                 if (z2) {
@@ -191,6 +195,15 @@ ShepardField shepard_interpolate(std::size_t n_dem, const std::vector<CouplingPa
     out.u[i] /= out.s[i];
     out.eps[i] /= out.s[i];
   }
+  return out;
+}
+
+std::vector<Vec3> shepard_rate(const std::vector<CouplingPair>& pairs, double mass, const std::vector<double>& rho,
+                               const std::vector<Vec3>& v, const ShepardField& at, const std::vector<Vec3>& c) {
+  std::vector<Vec3> out(at.u.size(), Vec3::Zero());
+  for (const CouplingPair& p : pairs)
+    out[p.i] += (mass / rho[p.a] * p.dw.dot(c[p.i] - v[p.a])) * (v[p.a] - at.u[p.i]);
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] /= at.s[i];
   return out;
 }
 

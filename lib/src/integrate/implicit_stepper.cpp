@@ -60,20 +60,29 @@ ImplicitStepper::Attempt ImplicitStepper::attempt(double dt, const ImplicitDrift
   const bool bdf2 = opt_.order == 2 && history_ >= 1;
   const double om = dt / dt_;
   const double c = bdf2 ? (1 + om) / (1 + 2 * om) : 1.0;
-  const bool accelerating = !d.w1.empty();
+  const bool accelerating = !d.w1.empty(), carried = !d.u.empty();
+  const double a1 = (1 + om) * (1 + om) / (1 + 2 * om), a2 = om * om / (1 + 2 * om);
   b_.resize(n);
   mob_.resize(n);
+  if (carried) carrier_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     mob_[i] = c * dt * d.inv_gamma[i];
     const Vec3 w = bdf2 ? Vec3((1 + om) * d.w0[i] - om * w_prev_[i]) : d.w0[i];
-    const Vec3 drift = accelerating ? Vec3(w + dt * d.w1[i]) : w;
-    if (bdf2) {
-      const double a1 = (1 + om) * (1 + om) / (1 + 2 * om), a2 = om * om / (1 + 2 * om);
-      b_[i] = a1 * x0_[i] - a2 * image_near(x0_[i], x_prev_[i], box) + c * dt * drift;
-    } else {
-      b_[i] = x0_[i] + dt * drift;
+    if (carried) {
+      carrier_[i] = dt * d.u[i];
+      if (accelerating) carrier_[i] += (0.5 * dt * dt) * d.w1[i];
+      b_[i] = bdf2 ? Vec3(a1 * x0_[i] - a2 * (image_near(x0_[i], x_prev_[i], box) + carrier_prev_[i]) + carrier_[i] +
+                          c * dt * w)
+                   : Vec3(x0_[i] + carrier_[i] + dt * w);
+      continue;
     }
+    const Vec3 drift = accelerating ? Vec3(w + dt * d.w1[i]) : w;
+    b_[i] = bdf2 ? Vec3(a1 * x0_[i] - a2 * image_near(x0_[i], x_prev_[i], box) + c * dt * drift)
+                 : Vec3(x0_[i] + dt * drift);
   }
+  // the fluid's response to the contact forces: over the whole step at its
+  // end (c dt dt), or along the carrier's path (dt^2 / 2)
+  const double response_scale = carried ? 0.5 * dt * dt : c * dt * dt;
   walls.x = walls0_.x;
   move_walls(walls, p_.shear_rate, dt);
   Attempt a;
@@ -81,7 +90,7 @@ ImplicitStepper::Attempt ImplicitStepper::attempt(double dt, const ImplicitDrift
     // Starts from the contact forces at x_n (walls at t_n).
     dual_.set_preconditioner(opt_.dual_preconditioner);
     a.newton = dual_.solve(candidates_, b_, x0_, walls0_, walls, box, p_.radius, p_.hertz_k, mob_, d.coupling,
-                           c * dt * dt, nopt, f.x);
+                           response_scale, nopt, f.x);
   } else {
     if (d.coupling || std::any_of(d.inv_gamma.begin(), d.inv_gamma.end(),
                               [&](double g) { return g != d.inv_gamma.front(); }))
@@ -109,13 +118,26 @@ ImplicitStepper::Attempt ImplicitStepper::attempt(double dt, const ImplicitDrift
     l1 = (dt - t0) * dt / ((t1 - t0) * t1);
     l2 = (dt - t0) * (dt - t1) / (t0 * t1);
   }
+  if (carried && d.coupling) {  // D_n += (dt^2/2) C F_c
+    contact_forces_end(f, walls, box, fc_scratch_);
+    d.coupling->add(fc_scratch_, response_scale, carrier_);
+  }
+  // Positions relative to the carrier's position X at t_n: x_n itself,
+  // x_{n-1} + D_{n-1}, x_{n-2} + D_{n-1} + D_{n-2}, and x - D_n at t_{n+1}.
+  const Vec3 zero = Vec3::Zero();
   for (std::size_t i = 0; i < n; ++i) {
+    const Vec3& dn = carried ? carrier_[i] : zero;
+    const Vec3& d1 = carried && history_ >= 1 ? carrier_prev_[i] : zero;
+    const Vec3& d2 = carried && history_ >= 2 ? carrier_prev2_[i] : zero;
     if (quadratic) {
-      const Vec3 pred =
-          l0 * image_near(x0_[i], x_prev2_[i], box) + l1 * image_near(x0_[i], x_prev_[i], box) + l2 * x0_[i];
-      a.error = std::max(a.error, k_bdf2_error_constant * (f.x[i] - pred).norm());
+      const Vec3 pred = l0 * (image_near(x0_[i], x_prev2_[i], box) + d1 + d2) +
+                        l1 * (image_near(x0_[i], x_prev_[i], box) + d1) + l2 * x0_[i];
+      a.error = std::max(a.error, k_bdf2_error_constant * (f.x[i] - dn - pred).norm());
     } else {
-      a.error = std::max(a.error, 0.5 * (f.x[i] - x0_[i] - dt * f.v[i]).norm());
+      // the last step's mean velocity relative to its carrier (at the first
+      // step, relative to the carrier now)
+      const Vec3 v_rel = !carried ? f.v[i] : history_ >= 1 ? Vec3(f.v[i] - d1 / dt_) : Vec3(f.v[i] - d.u[i]);
+      a.error = std::max(a.error, 0.5 * (f.x[i] - x0_[i] - dn - dt * v_rel).norm());
     }
     Vec3 step = f.x[i] - x0_[i];
     step.z() -= p_.shear_rate * dt * x0_[i].x();  // less the affine part (the candidates' bound)
@@ -165,13 +187,15 @@ double ImplicitStepper::advance(const ImplicitDrift& d, FreeParticles& f, WallPa
       dt_try_ = std::min(dt_max_, dt * std::min(growth, 0.9 * std::pow(std::max(ratio, 1e-6), exponent)));
       newton_cap_ *= k_newton_cap_relax;
       dt_try_ = std::min(dt_try_, newton_cap_);
-      if (opt_.order == 2) {
-        x_prev2_.swap(x_prev_);
-        x_prev_ = x0_;
-        w_prev_ = d.w0;
-        dt_prev2_ = dt_;
-        history_ = std::min(history_ + 1, 2);
+      x_prev2_.swap(x_prev_);
+      x_prev_ = x0_;
+      w_prev_ = d.w0;
+      if (!d.u.empty()) {
+        carrier_prev2_.swap(carrier_prev_);
+        carrier_prev_ = carrier_;
       }
+      dt_prev2_ = dt_;
+      history_ = std::min(history_ + 1, 2);
       break;
     }
     ++(a.newton.converged ? counters_.rejected : counters_.newton_failures);

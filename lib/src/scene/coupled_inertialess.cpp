@@ -37,13 +37,22 @@ void CoupledModel::inertialess_step() {
   for (std::size_t i = 0; i < n; ++i) {
     f_nc[i] = f.f[i] - fc[i] + body_force_;  // non-contact, non-hydrodynamic force at x_n (N)
     drift_.inv_gamma[i] = 1.0 / coupling_.gamma[i];
-    drift_.w0[i] = u_at_[i] + drift_.inv_gamma[i] * (f_nc[i] + buoyancy_[i]);
+    drift_.w0[i] = drift_.inv_gamma[i] * (f_nc[i] + buoyancy_[i]);  // relative to the carrier u_at_
     // The fluid at the particle feels its own forces (coupling_.g adds back
     // the reaction of the buoyancy, which the particle passes on with the
     // rest) and, through C, what every particle passes to it.
     drift_.w1[i] = coupling_.g[i] + coupling_.inv_mass[i] * buoyancy_[i];
   }
   response_.add(f_nc, 1.0, drift_.w1);
+  // The carrier as the particle samples it changes also because the particle
+  // and the SPH particles move (shepard_rate): the particle at u + v_rel,
+  // v_rel its drift relative to the carrier at x_n, so that the carrier's
+  // path is second order.
+  std::vector<Vec3> v_p(n);
+  for (std::size_t i = 0; i < n; ++i) v_p[i] = u_at_[i] + drift_.w0[i] + drift_.inv_gamma[i] * fc[i];
+  const std::vector<Vec3> sampled = shepard_rate(pairs_, fluid_.mass, fluid_.fluid.rho, fluid_.fluid.v, shepard_, v_p);
+  for (std::size_t i = 0; i < n; ++i) drift_.w1[i] += sampled[i];
+  drift_.u = u_at_;
   const double dt = implicit_->advance(drift_, f, cell_.walls, cell_.box, time_, steps_);
   advance_pair_lists(lists_, p_.shear_rate * dt);
   implicit_->contact_forces_end(f, cell_.walls, cell_.box, fc_end_);

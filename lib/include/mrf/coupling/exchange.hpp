@@ -24,11 +24,13 @@
 namespace mrf {
 
 // One DEM-SPH pair within the kernel support 2h: W = W(|x_i - x_a|, h) (1/m^3)
-// of the minimum image.
+// and its gradient with respect to x_i, dw = W'(r) (x_i - x_a) / r (1/m^4),
+// of the image the pair is for.
 struct CouplingPair {
   std::uint32_t i;  // DEM particle
   std::uint32_t a;  // SPH particle
   double w;
+  Vec3 dw;
 };
 
 // All DEM-SPH pairs closer than 2h (cell lists, periodic in y and z). When
@@ -104,6 +106,16 @@ struct ShepardField {
 ShepardField shepard_interpolate(std::size_t n_dem, const std::vector<CouplingPair>& pairs, double mass,
                                  const std::vector<double>& rho, const std::vector<Vec3>& v,
                                  const std::vector<double>& eps);
+
+// How fast the Shepard interpolant u_i = sum_a (m/rho_a) W(x_i - x_a) v_a / s_i
+// changes at DEM particle i moving at c_i while the SPH particles move at
+// their velocities v_a (v_a and rho_a held): the exact time derivative
+//   du_i/dt = sum_a (m/rho_a) (v_a - u_i) (dw_ia . (c_i - v_a)) / s_i   (m/s^2),
+// with s and u from shepard_interpolate on the same pairs, mass, rho and v.
+// In a smooth flow it is (c_i - u_i) . grad u; it also holds the flicker of
+// the interpolant as the SPH particles stream past.
+std::vector<Vec3> shepard_rate(const std::vector<CouplingPair>& pairs, double mass, const std::vector<double>& rho,
+                               const std::vector<Vec3>& v, const ShepardField& at, const std::vector<Vec3>& c);
 
 // Generalised buoyancy of the averaged equations (model A, REFERENCE §6):
 //   F_i = V_p (-grad p + div tau)_i = V_p sum_a (m/rho_a) W_ia (rho_a a_a) / s_i,

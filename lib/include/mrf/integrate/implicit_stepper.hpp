@@ -22,6 +22,18 @@
 //   order 2: omega = dt/dt_{n-1}, c = (1+omega)/(1+2 omega),
 //            b = a1 x_n - a2 x_{n-1} + c dt ((1+omega) w0_n - omega w0_{n-1} + dt w1_n),
 //            a1 = (1+omega)^2/(1+2 omega), a2 = omega^2/(1+2 omega),
+// With a carrier velocity u (the SPH fluid at the particle), the drift is
+// split into the carrier's path over the step,
+//   D_n = dt u_n + (dt^2/2) (w1_n + C F_c)   (constant acceleration),
+// and the motion y = x - X relative to it, which the formulas above advance
+// with w0 the relative drift alone: order 2 becomes
+//   x = a1 x_n - a2 (x_{n-1} + D_{n-1}) + D_n + c dt ((1+omega) w0_n - omega w0_{n-1} + F_c/gamma),
+// order 1 x = x_n + D_n + dt (w0_n + F_c/gamma), and the error is estimated
+// on y. Two reasons: extrapolating u as part of w0 counts the fluid's
+// acceleration twice (once in the extrapolation, once in w1), a first-order
+// error; and the explicit SPH carrier's step-to-step (acoustic) noise in u,
+// which the fluid's own step bounds, would otherwise set the particles'
+// error estimate and shorten their steps.
 // solved for the contact forces (integrate/contact_dual.hpp, the default)
 // or the positions (implicit_contact.hpp; uniform mobility only). The local
 // error is estimated against a predictor (order 1: x_n + dt v_n; order 2:
@@ -70,11 +82,14 @@ struct ImplicitCounters {
 
 // The explicit part of one step and the mobility (see the header comment).
 // w1 may be empty and coupling null (imposed flow: zero).
+// With a carrier (u not empty), w0 holds the particle's drift relative to
+// the carrier only, and the step is taken in the carrier's frame (below).
 struct ImplicitDrift {
   std::vector<Vec3> w0;           // m/s
   std::vector<Vec3> w1;           // m/s^2
   std::vector<double> inv_gamma;  // 1/gamma_i (s/kg)
   MobilityCoupling* coupling = nullptr;
+  std::vector<Vec3> u;            // carrier velocity at the particle at t_n (m/s); empty: none
 };
 
 // Contact geometry and law of the step: identical spheres of `radius` (m),
@@ -117,7 +132,8 @@ class ImplicitStepper {
   // The history (last steps, next try, counters); the near list is derived.
   template <class Archive, class Self>
   static void serialize(Archive& ar, Self& s) {
-    ar.io(s.dt_, s.dt_try_, s.newton_cap_, s.counters_, s.x_prev_, s.x_prev2_, s.w_prev_, s.dt_prev2_, s.history_);
+    ar.io(s.dt_, s.dt_try_, s.newton_cap_, s.counters_, s.x_prev_, s.x_prev2_, s.w_prev_, s.carrier_prev_,
+          s.carrier_prev2_, s.dt_prev2_, s.history_);
   }
   void save(ArchiveWriter& out) const { serialize(out, *this); }
   void load(ArchiveReader& in) {
@@ -149,12 +165,13 @@ class ImplicitStepper {
   std::vector<ContactPair> near_ff_;
   std::vector<Vec3> near_x_;
   double near_reach_, near_strain_ = 0;
-  std::vector<Vec3> x0_, b_, fc_;
+  std::vector<Vec3> x0_, b_, fc_, carrier_, fc_scratch_;  // carrier_: D_n of the attempt
   std::vector<double> mob_;
   WallParticles walls0_;
-  // order 2: positions and explicit drift w0 of the last accepted steps,
-  // the step before dt_ (s), and how many accepted steps they hold (<= 2)
-  std::vector<Vec3> x_prev_, x_prev2_, w_prev_;
+  // positions, explicit drift w0 (order 2) and carrier paths D of the last
+  // accepted steps, the step before dt_ (s), and how many accepted steps
+  // they hold (<= 2)
+  std::vector<Vec3> x_prev_, x_prev2_, w_prev_, carrier_prev_, carrier_prev2_;
   double dt_prev2_ = 0;
   int history_ = 0;
 };
