@@ -51,7 +51,9 @@ class FluidResponse final : public MobilityCoupling {
   // few microseconds); the choice depends on the pairs alone.
   static constexpr std::size_t k_entries_per_thread = 20000;
   std::vector<double> diag_;
-  std::vector<double> z_;             // per SPH particle, by component: sum_j W_aj f_j / (rho_a s_j)
+  // scratch of add(), xyz padded to four doubles: the forces, per SPH
+  // particle sum_j W_aj f_j / (rho_a s_j), and the gathered response
+  std::vector<double> f4_, z4_, y4_;
   mutable std::vector<double> dense_; // scratch of coupling(): per SPH particle, zero between calls
 };
 
