@@ -62,3 +62,20 @@ TEST(SphKernel, LatticeSumsCloseToOne) {
 
 }  // namespace
 }  // namespace mrf
+
+namespace mrf {
+namespace {
+// KernelW (alpha computed once, what the pair loops call) is the law of
+// kernel_w and kernel_dwdr_over_r bit for bit, inside and at the support.
+TEST(SphKernel, HoistedKernelEqualsTheFreeFunctionsBitForBit) {
+  for (double h : {1.3e-6, 6.5e-6, 1.95e-5}) {
+    const KernelW w(h);
+    for (int k = 0; k <= 2100; ++k) {
+      const double r = 1e-3 * k * h;
+      ASSERT_EQ(w(r), kernel_w(r, h)) << "r/h " << r / h;
+      ASSERT_EQ(w.dwdr_over_r(r), kernel_dwdr_over_r(r, h)) << "r/h " << r / h;
+    }
+  }
+}
+}  // namespace
+}  // namespace mrf

@@ -100,7 +100,7 @@ void coupling_pairs_of(const std::vector<IndexPair>& candidates, const std::vect
                 if (dx2 >= rc2) continue;  // x is not periodic: cheap rejection first
                 auto push = [&, i = i, a = a](double ey, double ez, double q2) {
                   const double r = std::sqrt(q2);
-                  mine.push_back({i, a, w(r), kernel_dwdr_over_r(r, h) * Vec3(dx, ey, ez)});
+                  mine.push_back({i, a, w(r), w.dwdr_over_r(r) * Vec3(dx, ey, ez)});
                 };
                 const double dy = mi.wrap_y(xi.y() - xa.y()), dz = mi.wrap_z(xi.z() - xa.z());
                 const double r2 = dx2 + dy * dy + dz * dz;

@@ -31,6 +31,13 @@ struct KernelW {
     const double t = 1.0 - 0.5 * q;
     return alpha * t * t * t * t * (2.0 * q + 1.0);
   }
+  // (dW/dr)/r, the same law as kernel_dwdr_over_r below, bit for bit
+  double dwdr_over_r(double r) const {
+    const double q = r / h;
+    if (q >= k_kernel_support) return 0.0;
+    const double t = 1.0 - 0.5 * q;
+    return -5.0 * alpha * t * t * t / (h * h);
+  }
 };
 
 // W(r, h) in 1/m^3; zero for r >= 2h.
