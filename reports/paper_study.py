@@ -185,7 +185,10 @@ def main(argv):
         lines += ["## The quasi-static limit (issue 17)", "",
                   "AQS wall stress of the paper cell (mrf quasistatic; reports/quasistatic/paper/), in φμ0M², beside "
                   "the particle part of each model's wall stress and model 1's volume side less eta gdot at the "
-                  "lowest Mn run. In AQS there is no carrier and wall = virial at every minimum.", "",
+                  "lowest Mn run. In AQS there is no carrier and wall = virial at every minimum. The realisations "
+                  "(seeds, increments) scatter by far more than each run's block error: the value to quote is "
+                  "their mean with the standard error of their scatter over a common window "
+                  "(reports/quasistatic/README.md §5).", "",
                   "| AQS run | stress / (phi mu0 M^2) | note |", "|---|---:|---|"]
         for r in qs:
             lines.append(f"| {r['run']} | {num(r, 'stress_over_phi_mu0_m2'):.5f} ± {num(r, 'err'):.5f} | "
