@@ -26,14 +26,14 @@ constexpr double kDx = 5e-6;       // fluid spacing (m)
 constexpr double kR = 2.5e-6;      // DEM radius (m), d = 5 um
 const double kVp = sphere_volume(kR);
 
-// Fluid at rest, gap 24 dx, ly = lz = 12 dx (>= 4h), h = 1.3 dx.
-FluidCell make_cell() {
+// Fluid at rest, h = 1.3 dx; by default gap 24 dx, ly = lz = 12 dx (>= 4h).
+FluidCell make_cell(const Box& box = Box{24 * kDx, 12 * kDx, 12 * kDx}) {
   FluidParams p;
   p.viscosity = 0.1;
   p.density = 1000.0;
   p.spacing = kDx;
   p.sound_speed = 1.0;
-  return build_fluid_cell(Box{24 * kDx, 12 * kDx, 12 * kDx}, p);
+  return build_fluid_cell(box, p);
 }
 
 std::vector<Vec3> random_points(std::size_t n, double x_lo, double x_hi, const Box& box, unsigned seed) {
@@ -86,13 +86,8 @@ TEST(CouplingExchange, PairsAreTheSameOnAnyNumberOfThreads) {
 // missing -u_i (the Shepard normalisation) or -v_a (the SPH particles'
 // motion) fails by O(1).
 TEST(CouplingExchange, ShepardRateIsTheTimeDerivativeOfTheInterpolant) {
-  FluidParams p;
-  p.viscosity = 0.1;
-  p.density = 1000.0;
-  p.spacing = kDx;
-  p.sound_speed = 1.0;
   for (const Box& box : {Box{24 * kDx, 12 * kDx, 12 * kDx}, Box{24 * kDx, 3 * kDx, 4 * kDx}}) {
-    const FluidCell c = build_fluid_cell(box, p);
+    const FluidCell c = make_cell(box);
     const auto dem = random_points(30, -0.4 * box.gap, 0.4 * box.gap, box, 11);
     std::mt19937_64 gen(3);
     std::normal_distribution<double> g;
@@ -126,12 +121,7 @@ TEST(CouplingExchange, ShepardRateIsTheTimeDerivativeOfTheInterpolant) {
 // over all images (|k| <= 2 covers the support). With a single image the
 // weight of a particle near y = 0 would miss the far image.
 TEST(CouplingExchange, PairsSumEveryPeriodicImageInNarrowBoxes) {
-  FluidParams p;
-  p.viscosity = 0.1;
-  p.density = 1000.0;
-  p.spacing = kDx;
-  p.sound_speed = 1.0;
-  const FluidCell c = build_fluid_cell(Box{24 * kDx, 3 * kDx, 4 * kDx}, p);  // ly, lz < 4h = 5.2 dx
+  const FluidCell c = make_cell(Box{24 * kDx, 3 * kDx, 4 * kDx});  // ly, lz < 4h = 5.2 dx
   const auto dem = random_points(40, -0.5 * c.box.gap, 0.5 * c.box.gap, c.box, 7);
   const auto pairs = coupling_pairs(dem, c.fluid.x, c.box, c.h);
   std::vector<double> sum(dem.size(), 0.0), expect(dem.size(), 0.0);
@@ -152,12 +142,7 @@ TEST(CouplingExchange, PairsSumEveryPeriodicImageInNarrowBoxes) {
 // only some of the steps: the rebuild bound holds and the cache is used.
 TEST(CouplingExchange, CachedPairsEqualAFreshSearchAtEveryStep) {
   for (const Box& box : {Box{24 * kDx, 12 * kDx, 12 * kDx}, Box{24 * kDx, 3 * kDx, 4 * kDx}}) {
-    FluidParams p;
-    p.viscosity = 0.1;
-    p.density = 1000.0;
-    p.spacing = kDx;
-    p.sound_speed = 1.0;
-    const FluidCell c = build_fluid_cell(box, p);
+    const FluidCell c = make_cell(box);
     std::vector<Vec3> dem = random_points(300, -0.5 * box.gap, 0.5 * box.gap, box, 11), sph = c.fluid.x;
     CouplingPairCache cache;
     cache.skin = 0.3 * c.h;
