@@ -157,5 +157,63 @@ TEST(ContactDual, IncompleteCholeskyGivesTheJacobiTrajectoryInFewerIterations) {
   EXPECT_LT(2 * cg_ic, cg_j) << "IC(0) must at least halve the CG iterations";
 }
 
+
+// A uniform shared fluid: C_ij = c for every pair (what one kernel gives
+// particles far closer than h), enough to test the coupled preconditioner.
+class UniformCoupling final : public MobilityCoupling {
+ public:
+  explicit UniformCoupling(double c) : c_(c) {}
+  void add(const std::vector<Vec3>& f, double scale, std::vector<Vec3>& y,
+           const std::vector<std::uint32_t>* rows) override {
+    Vec3 sum = Vec3::Zero();
+    for (const Vec3& v : f) sum += v;
+    if (rows) {
+      for (std::uint32_t i : *rows) y[i] += scale * c_ * sum;
+    } else {
+      for (Vec3& v : y) v += scale * c_ * sum;
+    }
+  }
+  double diagonal(std::size_t) const override { return c_; }
+  double coupling(std::size_t, std::size_t) const override { return c_; }
+
+ private:
+  double c_;
+};
+
+// One sphere pressed between two walls, in a fluid whose response to the
+// walls' unbalanced push is 50x the drag's mobility. Both wall contacts act
+// on the same sphere, so s C enters their off-diagonal entry; IC(0) with it
+// is the exact factor and each Newton solve needs one CG iteration (with
+// the coupling on the diagonal only, as before, it needs two). The forces
+// that come out balance the step's equation and the Hertz law.
+TEST(ContactDual, CoupledWallContactsOfOneSphereFactorExactly) {
+  const double r = 1e-6, k = 1e4, mob = 1e-3, c = 5e4, s = 1e-6;  // s c = 50 mob
+  const Box box{10 * r, 10 * r, 10 * r};
+  WallParticles walls;
+  walls.x = {Vec3(-1.99 * r, 0, 0), Vec3(1.995 * r, 0, 0)};
+  walls.side = {-1, 1};
+  const std::vector<ContactPair> pairs = {{0, 0, true}, {0, 1, true}};
+  const std::vector<Vec3> x0 = {Vec3::Zero()}, b = {Vec3(2e-3 * r, 0, 0)};
+  UniformCoupling fluid(c);
+  ContactDual dual;
+  dual.set_preconditioner(ContactDual::Preconditioner::incomplete_cholesky);
+  NewtonOptions opt;
+  opt.tol = 1e-12 * r;
+  opt.max_iterations = 50;
+  opt.linear_rtol = 1e-12;
+  std::vector<Vec3> y;
+  const NewtonResult res = dual.solve(pairs, b, x0, walls, walls, box, r, k, {mob}, &fluid, s, opt, y);
+  ASSERT_TRUE(res.converged) << "last correction " << res.last_correction;
+  EXPECT_LE(res.linear_iterations, res.iterations - 1) << "one CG iteration per Newton solve";
+  std::vector<Vec3> f(1, Vec3::Zero());
+  dual.add_forces(pairs, f);
+  // y = b + (mob + s c) f, and each force is the Hertz force of its overlap
+  EXPECT_NEAR(y[0].x(), b[0].x() + (mob + s * c) * f[0].x(), 1e-9 * r);
+  const double left = 2 * r - (y[0].x() - walls.x[0].x()), right = 2 * r - (walls.x[1].x() - y[0].x());
+  EXPECT_GT(left, 0.0);
+  EXPECT_GT(right, 0.0);
+  EXPECT_NEAR(f[0].x(), k * std::pow(left, 1.5) - k * std::pow(right, 1.5), 1e-9 * k * std::pow(left, 1.5));
+}
+
 }  // namespace
 }  // namespace mrf

@@ -62,8 +62,14 @@ class ContactDual {
   // (A + C) p on the active set
   void apply(const std::vector<ContactPair>& pairs, const std::vector<double>& p, std::vector<double>& out);
   long solve_cg(const std::vector<ContactPair>& pairs, double rtol);
-  // Incomplete Cholesky IC(0) of the assembled A + C on the active set
-  // (the coupled part by its diagonal only), the CG preconditioner: A
+  // Incomplete Cholesky IC(0) of the assembled A + C on the active set,
+  // the CG preconditioner. The coupled part s G^T C G enters by its
+  // diagonal and by the entries of contact pairs that share a sphere when
+  // one of the two is a wall contact: a wall contact's force is the one
+  // the fluid does not see balanced (an interior contact's equal and
+  // opposite forces meet a nearly equal response at both ends, so between
+  // two interior contacts the entry is a second difference of C and is
+  // left out). A
   // couples two contacts only through a sphere they share, so its graph is
   // the line graph of the contact network, and along chains (a tree of
   // contacts: cliques joined at spheres) IC(0) is close to the exact
@@ -73,13 +79,19 @@ class ContactDual {
 
   // Per candidate pair: force (N), compliance slope (m/N), Newton
   // right-hand side (m), unit normal (k to i; frozen over a linear solve).
-  std::vector<double> lambda_, comp_, rhs_, crel_;
+  // Coupled solves: s (C_ii + C_kk - 2 C_ik) and C_ik (0 for a wall pair).
+  std::vector<double> lambda_, comp_, rhs_, crel_, cik_;
   std::vector<Vec3> n_;
   std::vector<std::uint32_t> act_;           // active pairs
   std::vector<std::uint32_t> act_particles_;  // the spheres of active pairs, ascending
   std::vector<std::uint32_t> seen_;           // per sphere: the iteration that listed it in act_particles_
   std::vector<double> d_, r_, diag_, dq_;           // CG on the active set: solution, right-hand side, Jacobi diagonal
   PcgScratch<double> cg_;
+  // The last Newton update, for a backtrack: forces, positions and normals
+  // before it, its active set and its direction.
+  std::vector<double> lambda_prev_, d_prev_;
+  std::vector<Vec3> y_prev_, n_prev_;
+  std::vector<std::uint32_t> act_prev_;
   // IC(0): the strictly lower part of L by rows (columns ascending) and its
   // diagonal; per sphere its active contacts (CSR over the spheres).
   std::vector<std::uint32_t> l_start_, l_col_, sph_start_, sph_act_;
