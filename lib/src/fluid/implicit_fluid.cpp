@@ -91,9 +91,14 @@ std::vector<double> ImplicitFluidSystem::density_change(const std::vector<Vec3>&
 
 // out += dt^2 S1 D^T Q (D x + with_d0 d0); s_ keeps Q (D x + d0) dt^2 S1
 void ImplicitFluidSystem::add_pressure(const std::vector<Vec3>& x, bool with_d0, std::vector<Vec3>& out) const {
-  const auto& pairs = c_.pairs.fluid_fluid;
-  const std::size_t n = x.size();
   divergence(x, with_d0, s_);
+  scatter_pressure(out);
+}
+
+// s_ *= Q, out += D^T s_
+void ImplicitFluidSystem::scatter_pressure(std::vector<Vec3>& out) const {
+  const auto& pairs = c_.pairs.fluid_fluid;
+  const std::size_t n = out.size();
   for (std::size_t a = 0; a < n; ++a) {
     s_[a] *= q_[a];
     out[a] += s_[a] * tw_[a];
@@ -110,11 +115,26 @@ void ImplicitFluidSystem::apply(const std::vector<Vec3>& x, std::vector<Vec3>& o
   const std::size_t n = x.size();
   out.resize(n);
   for (std::size_t a = 0; a < n; ++a) out[a] = vdiag_[a] * x[a];
-  for (std::size_t e = 0; e < pairs.size(); ++e) {
-    out[pairs[e].a] -= k_[e] * x[pairs[e].b];
-    out[pairs[e].b] -= k_[e] * x[pairs[e].a];
+  if (!pressure_) {
+    for (std::size_t e = 0; e < pairs.size(); ++e) {
+      out[pairs[e].a] -= k_[e] * x[pairs[e].b];
+      out[pairs[e].b] -= k_[e] * x[pairs[e].a];
+    }
+    return;
   }
-  if (pressure_) add_pressure(x, false, out);
+  // the viscous product and the divergence D x in one pass over the pairs
+  // (each sum in the same order as two passes), then the pressure's
+  s_.resize(n);
+  for (std::size_t a = 0; a < n; ++a) s_[a] = tw_[a].dot(x[a]);
+  for (std::size_t e = 0; e < pairs.size(); ++e) {
+    const std::uint32_t a = pairs[e].a, b = pairs[e].b;
+    out[a] -= k_[e] * x[b];
+    out[b] -= k_[e] * x[a];
+    const double d = g_[e].dot(x[a] - x[b]);
+    s_[a] += d;
+    s_[b] += d;
+  }
+  scatter_pressure(out);
 }
 
 std::vector<Vec3> ImplicitFluidSystem::rhs(const std::vector<Vec3>& v_star) const {

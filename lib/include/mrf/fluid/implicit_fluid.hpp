@@ -66,6 +66,7 @@ class ImplicitFluidSystem {
  private:
   void divergence(const std::vector<Vec3>& x, bool with_d0, std::vector<double>& s) const;  // s = D x (+ d0)
   void add_pressure(const std::vector<Vec3>& x, bool with_d0, std::vector<Vec3>& out) const;
+  void scatter_pressure(std::vector<Vec3>& out) const;  // s_ *= Q, out += D^T s_ (add_pressure after the divergence)
   const FluidCell& c_;
   double dt_;
   bool pressure_;
