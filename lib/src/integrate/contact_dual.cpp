@@ -237,6 +237,18 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
   y = b;
   move(pairs, lambda_, false, y);
   const double k23 = std::cbrt(hertz_k * hertz_k);  // k^{2/3}
+  // lambda += t d on the active set (projected on lambda >= 0), y moved by
+  // the change along the current normals
+  auto update = [&](double t, const std::vector<double>& d, std::vector<Vec3>& y_out) {
+    dq_.resize(act_.size());
+    for (std::size_t a = 0; a < act_.size(); ++a) {
+      const std::uint32_t c = act_[a];
+      const double updated = std::max(0.0, lambda_[c] + t * d[a]);
+      dq_[a] = updated - lambda_[c];
+      lambda_[c] = updated;
+    }
+    move(pairs, dq_, true, y_out);
+  };
   NewtonResult res;
   double prev_worst = 0, theta = 1.0;
   for (res.iterations = 1; res.iterations <= opt.max_iterations; ++res.iterations) {
@@ -285,26 +297,18 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
     }
     // Backtracking: an update that more than doubled the largest residual
     // is undone and taken at half its length (down to 1/8; each try counts
-    // as an iteration). Without it the
-    // coupled solve can cycle: a contact that opens leaves a force the
-    // fluid does not see balanced, the fluid response moves a whole
-    // neighbourhood by more than the residual it fixed, the contact closes
-    // again (seen on the small scene at 2000 1/s, model 3: periods of 2 and
-    // 3 iterations until the 20 allowed ran out).
+    // as an iteration). Without it the coupled solve can cycle: a contact
+    // that opens leaves a force the fluid does not see balanced, the fluid
+    // response moves a whole neighbourhood by more than the residual it
+    // fixed, the contact closes again (seen on the small scene at 2000 1/s,
+    // model 3: periods of 2 and 3 iterations until the 20 allowed ran out).
     if (res.iterations > 1 && worst > opt.tol && worst > 2.0 * prev_worst && theta > 0.2) {
       theta *= 0.5;
-      dq_.resize(act_prev_.size());
       lambda_ = lambda_prev_;
       y = y_prev_;
       n_.swap(n_prev_);
-      for (std::size_t a = 0; a < act_prev_.size(); ++a) {
-        const std::uint32_t c = act_prev_[a];
-        const double updated = std::max(0.0, lambda_[c] + theta * d_prev_[a]);
-        dq_[a] = updated - lambda_[c];
-        lambda_[c] = updated;
-      }
       act_.swap(act_prev_);
-      move(pairs, dq_, true, y);
+      update(theta, d_prev_, y);
       act_.swap(act_prev_);
       n_.swap(n_prev_);
       continue;
@@ -324,14 +328,7 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
     n_prev_ = n_;
     act_prev_ = act_;
     d_prev_ = d_;
-    dq_.resize(act_.size());
-    for (std::size_t a = 0; a < act_.size(); ++a) {
-      const std::uint32_t c = act_[a];
-      const double updated = std::max(0.0, lambda_[c] + d_[a]);
-      dq_[a] = updated - lambda_[c];
-      lambda_[c] = updated;
-    }
-    move(pairs, dq_, true, y);
+    update(1.0, d_, y);
   }
   res.iterations = opt.max_iterations;
   return res;
