@@ -18,7 +18,9 @@
 // overlap itself; here the linear part dominates (A / C ~ mob k_eff,
 // the stiffness ratio of the step) and the Hertz nonlinearity is a small
 // correction, so Newton needs few iterations from the forces of the last step.
-// Open contacts are handled by projection (lambda >= 0) with an active set.
+// Open contacts are handled by projection (lambda >= 0) with an active set;
+// an update that more than doubles the largest residual is halved (down to
+// 1/8 of the Newton step), which stops the active set cycling.
 #pragma once
 #include <cstdint>
 #include <utility>
