@@ -9,11 +9,13 @@ still running: it reports what has finished and says what has not.
 usage: paper_study.py SWEEP_DIR OUT_DIR [--small reports/study/flow_curves.csv]
                       [--quasistatic reports/quasistatic/paper/results.csv]
                       [--fixed-m reports/study/paper/fixed_m_sweep.csv]
+                      [--fixed-m-criterion reports/study/paper/fixed_m_criterion.json]
 
 The fixed-M path (experiments/sweeps/paper_fixed_m.toml, collected with
-`mrf sweep ... --archive reports/study/paper/fixed_m_points --collect` and
-its sweep.csv copied to the --fixed-m path), when it exists, is tabulated
-against the realistic path at the same Mn.
+`mrf sweep ... --archive reports/study/paper/fixed_m_points --collect`, then
+`mrf criterion` on it; its sweep.csv and criterion.json copied to the two
+paths above), when it exists, is tabulated against the realistic path at
+the same Mn, both seed-combined by mrf criterion.
 
 The quasi-static (AQS, Mn -> 0) wall stress of the same cell, when its
 results table exists (columns run, stress_over_phi_mu0_m2, err, note; one
@@ -51,52 +53,44 @@ def steady(r):
     return abs(z) < DRIFT_Z and d < MSER_MAX
 
 
-def seed_mean(rs, key, scale):
-    """Seed mean of rs[key] / scale with err = max(within-run, scatter / sqrt(n))."""
-    v = [num(r, key) / scale for r in rs]
-    e = [num(r, key + "_err") / scale for r in rs]
-    n = len(v)
-    mean = sum(v) / n
-    within = math.sqrt(sum(x * x for x in e)) / n
-    scatter = math.sqrt(sum((x - mean) ** 2 for x in v) / (n - 1) / n) if n > 1 else 0.0
-    return mean, max(within, scatter)
-
-
 def two_paths(argv, here, crit, phi, models):
     """Issue 13's second path: the same cell at a fixed M = 1 MA/m, Mn set by
     the shear rate (experiments/sweeps/paper_fixed_m.toml), against the
     realistic path at the same Mn."""
     path = arg(argv, "--fixed-m", os.path.join(here, "study", "paper", "fixed_m_sweep.csv"))
-    if not os.path.exists(path):
+    crit_path = arg(argv, "--fixed-m-criterion", os.path.join(here, "study", "paper", "fixed_m_criterion.json"))
+    if not (os.path.exists(path) and os.path.exists(crit_path)):
         return []
-    fixed = defaultdict(list)
+    fixed = json.load(open(crit_path))  # the seed-combined points, as for the realistic path
+    dimless = {}  # St and Re_p of each (model, Mn), from the runs
     for r in read_rows(path):
         if r["status"] == "ok":
-            fixed[(r["model"], float(r["mason"]))].append(r)
+            dimless[(r["model"], float(r["mason"]))] = (num(r, "stokes_number"), num(r, "reynolds_number"))
     lines = ["## Two paths to a Mason number", "",
              "The realistic path (gdot = 1e3 1/s, M set by Mn: St and Re_p about 1e-4) against a fixed "
              "M = 1 MA/m with Mn set by the shear rate (experiments/sweeps/paper_fixed_m.toml: St = 0.30 Mn, "
-             "Re_p = 0.175 Mn). Total wall stress / (phi mu0 M^2), seed means, err = max(within-run, seed "
-             "scatter / sqrt(n)); the difference in combined standard errors. Where it is large, the model's "
+             "Re_p = 0.175 Mn). Total wall stress / (phi mu0 M^2), seed-combined by mrf criterion as the "
+             "realistic path is; the difference in combined standard errors. Where it is large, the model's "
              "behaviour at that Mn on the fixed-M path is inertia, not rheology.", "",
              "| model | Mn | seeds (fixed M) | fixed M | St, Re_p | realistic | fixed - realistic (sigma) | "
              "particle part: fixed M | realistic |",
              "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
     real = {(k, q["mason"]): q for k in models for q in crit["models"][k]["points"]}
-    for (k, mn), rs in sorted(fixed.items(), key=lambda kv: (ORDER.index(kv[0][0]), kv[0][1])):
-        sc = phi * MU0 * num(rs[0], "magnetization") ** 2
-        t, e = seed_mean(rs, "stress_total", sc)
-        pt, pe = seed_mean(rs, "stress_particles", sc)
-        st, re = num(rs[0], "stokes_number"), num(rs[0], "reynolds_number")
-        q = real.get((k, mn))
-        if q:
-            sr = phi * MU0 * q["magnetization"] ** 2
-            rt, re_ = q["stress"] / sr, q["err"] / sr
-            cmp_ = (f"{rt:.4f} ± {re_:.4f} | {(t - rt) / math.hypot(e, re_):+.1f} | {pt:.4f} ± {pe:.4f} | "
-                    f"{(q['stress'] - q['stress_fluid']) / sr:.4f} ± {re_:.4f}")
-        else:
-            cmp_ = f"– | – | {pt:.4f} ± {pe:.4f} | –"
-        lines.append(f"| {k} | {mn:g} | {len(rs)} | {t:.4f} ± {e:.4f} | {st:.2g}, {re:.2g} | {cmp_} |")
+    for k in [m for m in ORDER if m in fixed["models"]]:
+        for f in sorted(fixed["models"][k]["points"], key=lambda q: q["mason"]):
+            sc = phi * MU0 * f["magnetization"] ** 2
+            t, e = f["stress"] / sc, f["err"] / sc
+            pt = (f["stress"] - f["stress_fluid"]) / sc
+            st, re = dimless.get((k, f["mason"]), (float("nan"), float("nan")))
+            q = real.get((k, f["mason"]))
+            if q:
+                sr = phi * MU0 * q["magnetization"] ** 2
+                rt, re_ = q["stress"] / sr, q["err"] / sr
+                cmp_ = (f"{rt:.4f} ± {re_:.4f} | {(t - rt) / math.hypot(e, re_):+.1f} | {pt:.4f} ± {e:.4f} | "
+                        f"{(q['stress'] - q['stress_fluid']) / sr:.4f} ± {re_:.4f}")
+            else:
+                cmp_ = f"– | – | {pt:.4f} ± {e:.4f} | –"
+            lines.append(f"| {k} | {f['mason']:g} | {f['seeds']} | {t:.4f} ± {e:.4f} | {st:.2g}, {re:.2g} | {cmp_} |")
     lines.append("")
     return lines
 
