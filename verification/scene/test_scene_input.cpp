@@ -184,7 +184,7 @@ TEST(SceneInput, OptionalKeysTakeTheirDefaults) {
   EXPECT_EQ(c.implicit_tol, 1e-2);
   EXPECT_EQ(c.implicit_order, 2);
   EXPECT_EQ(c.sound_speed, 0.0);
-  EXPECT_EQ(c.threads, 0);
+  EXPECT_EQ(c.threads, 1);
   EXPECT_EQ(c.every, 0);
   EXPECT_EQ(c.frames, 0);
 }
