@@ -283,6 +283,45 @@ TEST(PairLoop, FlippedSignEvaluatorFailsTheCheck) {
 // so forces and sums agree to round-off; the overlap is a maximum of values
 // that differ by a few ulp. The configurations have
 // rows of every length, so both the vector body and the scalar tail run.
+// The kernel's own loads and stores (AVX2: one 4-wide load and store per
+// partner, which also touch the next sphere's x) against the scalar loop on
+// a list of every pair in range, each row in descending order: partners
+// that are neighbours in memory share a vector in most rows, k + 1 before k,
+// so a lane that stored the next sphere's x from before its neighbour's
+// update would lose that update (a whole pair force, not round-off); and
+// the last sphere, which has no next one, is a partner in many rows.
+TEST(PairLoop, VectorKernelWithNeighbouringPartnersEqualsTheScalarLoop) {
+  Case s = random_case(5, 1e6, false);
+  const std::size_t n = s.cell.free.size();
+  const double reach = std::max(s.p.dipole_cutoff, 2 * R);
+  PairRows rows;
+  rows.start.push_back(0);
+  std::size_t adjacent = 0, last = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t k = n - 1; k > i; --k) {
+      if (s.cell.box.min_image(s.cell.free.x[i] - s.cell.free.x[k]).norm() >= reach) continue;
+      if (rows.start.back() < rows.k.size() && rows.k.back() == k + 1) ++adjacent;
+      if (k == n - 1) ++last;
+      rows.k.push_back(static_cast<std::uint32_t>(k));
+    }
+    rows.start.push_back(static_cast<std::uint32_t>(rows.k.size()));
+  }
+  ASSERT_GT(adjacent, 100u);
+  ASSERT_GT(last, 10u);
+  const DemPairLaws<> laws = dem_pair_laws(s.p);
+  std::vector<Vec3> f_scalar(n, Vec3::Zero()), f_vector(n, Vec3::Zero());
+  PairSums scalar, vector;
+  detail::free_rows<true, false>(laws, s.cell.box, s.cell.free.x, rows, 0, n, f_scalar, scalar);
+  detail::free_rows_simd(laws, s.cell.box, s.cell.free.x, rows, 0, n, f_vector, vector);
+  double worst = 0, scale = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    worst = std::max(worst, (f_vector[i] - f_scalar[i]).norm());
+    scale = std::max(scale, f_scalar[i].norm());
+  }
+  EXPECT_LT(worst, 1e-12 * scale);
+  EXPECT_LT(std::abs(vector.energy_dipole - scalar.energy_dipole), 1e-12 * std::abs(scalar.energy_dipole));
+}
+
 TEST(PairLoop, VectorKernelEqualsTheScalarLoop) {
   std::printf("pair kernel target: %s\n", pair_kernel_target());
   for (std::uint64_t seed : {3u, 8u}) {

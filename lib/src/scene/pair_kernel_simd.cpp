@@ -10,7 +10,9 @@
 // from the packed Vec3 array, the laws of forces/ (dipole_x_law,
 // hertz_law_t) evaluated on whole vectors, a pair beyond the range masked
 // out, and the partners' forces gathered, decremented and scattered back (a
-// row's partners are distinct, so lanes never collide). The Hertz law runs on
+// row's partners are distinct, so lanes never collide). On AVX2, which has
+// no scatter, the partners' coordinates and forces move by 4-wide loads and
+// stores and 4 x 4 transposes instead. The Hertz law runs on
 // max(h, 0), which gives 0 without overlap, and only on vectors with a
 // contact in them. The tail of a row shorter than a vector runs the scalar
 // loop's pair (detail::pair_force). The pair forces are the scalar loop's expressions except 1/r
@@ -101,6 +103,7 @@ void FreeRowsOf(const DemPairLaws<Dipole, HertzPair>& laws, const Box& box, cons
   const auto ly = hn::Set(d, mi.ly), inv_ly = hn::Set(d, mi.inv_ly), lz = hn::Set(d, mi.lz), inv_lz = hn::Set(d, mi.inv_lz);
   const auto magic = hn::Set(d, 6755399441055744.0);  // MinImageYZ::round_nearest
   const std::uint32_t* ks = rows.k.data();
+  [[maybe_unused]] const std::uint32_t n_free = static_cast<std::uint32_t>(x.size());
   const double* xs = x.data()->data();  // Vec3: three packed doubles
   double* fs = f.data()->data();
   detail::PairTally s;
@@ -115,9 +118,37 @@ void FreeRowsOf(const DemPairLaws<Dipole, HertzPair>& laws, const Box& box, cons
     for (; n + lanes <= end; n += lanes) {
       const auto kk = hn::BitCast(di, hn::PromoteTo(du64, hn::LoadU(du, ks + n)));
       const auto k3 = hn::Add(hn::Add(kk, kk), kk);  // 3 k: x of partner k
-      const auto dx = hn::Sub(vxi, hn::GatherIndex(d, xs, k3));
-      auto dy = hn::Sub(vyi, hn::GatherIndex(d, xs + 1, k3));
-      auto dz = hn::Sub(vzi, hn::GatherIndex(d, xs + 2, k3));
+#if HWY_TARGET == HWY_AVX2
+      // AVX2 has no scatter (Highway stores lane by lane) and Zen 2's
+      // gathers are slow: each partner's (x, y, z) is one unaligned 4-wide
+      // load (the fourth double is the next sphere's x, unused), and a 4 x 4
+      // transpose makes the coordinate vectors. The last sphere has no next
+      // one: a vector that holds it takes the gathers.
+      const bool rows4 = ks[n] + 1 < n_free && ks[n + 1] + 1 < n_free && ks[n + 2] + 1 < n_free &&
+                         ks[n + 3] + 1 < n_free;
+      V px, py, pz;
+      if (rows4) {
+        const __m256d r0 = _mm256_loadu_pd(xs + 3 * std::size_t{ks[n]}),
+                      r1 = _mm256_loadu_pd(xs + 3 * std::size_t{ks[n + 1]}),
+                      r2 = _mm256_loadu_pd(xs + 3 * std::size_t{ks[n + 2]}),
+                      r3 = _mm256_loadu_pd(xs + 3 * std::size_t{ks[n + 3]});
+        const __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1);  // x0 x1 z0 z1, y0 y1 . .
+        const __m256d t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
+        px = V{_mm256_permute2f128_pd(t0, t2, 0x20)};
+        py = V{_mm256_permute2f128_pd(t1, t3, 0x20)};
+        pz = V{_mm256_permute2f128_pd(t0, t2, 0x31)};
+      } else {
+        px = hn::GatherIndex(d, xs, k3);
+        py = hn::GatherIndex(d, xs + 1, k3);
+        pz = hn::GatherIndex(d, xs + 2, k3);
+      }
+#else
+      const auto px = hn::GatherIndex(d, xs, k3), py = hn::GatherIndex(d, xs + 1, k3),
+                 pz = hn::GatherIndex(d, xs + 2, k3);
+#endif
+      const auto dx = hn::Sub(vxi, px);
+      auto dy = hn::Sub(vyi, py);
+      auto dz = hn::Sub(vzi, pz);
       dy = hn::Sub(dy, hn::Mul(ly, hn::Sub(hn::Add(hn::Mul(dy, inv_ly), magic), magic)));
       dz = hn::Sub(dz, hn::Mul(lz, hn::Sub(hn::Add(hn::Mul(dz, inv_lz), magic), magic)));
       const auto r2 = hn::Add(hn::Add(hn::Mul(dx, dx), hn::Mul(dy, dy)), hn::Mul(dz, dz));
@@ -143,6 +174,26 @@ void FreeRowsOf(const DemPairLaws<Dipole, HertzPair>& laws, const Box& box, cons
       gy = hn::IfThenElseZero(in_range, gy);
       gz = hn::IfThenElseZero(in_range, gz);
       fx = hn::Add(fx, gx), fy = hn::Add(fy, gy), fz = hn::Add(fz, gz);
+#if HWY_TARGET == HWY_AVX2
+      if (rows4) {
+        // the transpose back: (gx, gy, gz, 0) per partner, each subtracted
+        // from its force by one 4-wide load and store. The fourth double,
+        // the next sphere's x, is stored back unchanged (x - 0 = x), and
+        // each lane loads after the last one stored, so partners that are
+        // neighbours in memory see each other's update. f is this thread's
+        // own buffer.
+        const __m256d zero4 = _mm256_setzero_pd();
+        const __m256d u0 = _mm256_unpacklo_pd(gx.raw, gy.raw), u1 = _mm256_unpackhi_pd(gx.raw, gy.raw);
+        const __m256d u2 = _mm256_unpacklo_pd(gz.raw, zero4), u3 = _mm256_unpackhi_pd(gz.raw, zero4);
+        const __m256d g4[4] = {_mm256_permute2f128_pd(u0, u2, 0x20), _mm256_permute2f128_pd(u1, u3, 0x20),
+                               _mm256_permute2f128_pd(u0, u2, 0x31), _mm256_permute2f128_pd(u1, u3, 0x31)};
+        for (std::size_t l = 0; l < 4; ++l) {
+          double* fk = fs + 3 * std::size_t{ks[n + l]};
+          _mm256_storeu_pd(fk, _mm256_sub_pd(_mm256_loadu_pd(fk), g4[l]));
+        }
+        continue;
+      }
+#endif
       hn::ScatterIndex(hn::Sub(hn::GatherIndex(d, fs, k3), gx), d, fs, k3);
       hn::ScatterIndex(hn::Sub(hn::GatherIndex(d, fs + 1, k3), gy), d, fs + 1, k3);
       hn::ScatterIndex(hn::Sub(hn::GatherIndex(d, fs + 2, k3), gz), d, fs + 2, k3);
