@@ -51,20 +51,32 @@ void ContactDual::add_forces(const std::vector<ContactPair>& pairs, std::vector<
 void ContactDual::apply(const std::vector<ContactPair>& pairs, const std::vector<double>& p,
                         std::vector<double>& out) {
   const std::vector<double>& mob = *mob_;
+  out.resize(act_.size());
+  if (!coupled_) {  // the packed copy of this linear solve (solve_cg): no indirection, no branch
+    for (auto i : act_particles_) pdisp_[i].setZero();
+    for (std::size_t a = 0; a < packed_.size(); ++a) {
+      const Packed& e = packed_[a];
+      const Vec3 g = p[a] * e.n;
+      pdisp_[e.i] += e.mob_i * g;
+      pdisp_[e.k] -= e.mob_k * g;  // a wall pair: the spare row, 0 * g
+    }
+    for (std::size_t a = 0; a < packed_.size(); ++a) {
+      const Packed& e = packed_[a];
+      out[a] = e.n.dot(pdisp_[e.i] - pdisp_[e.k]) + e.comp * p[a];
+    }
+    return;
+  }
   for (auto i : act_particles_) disp_[i].setZero();
-  if (coupled_) s_.assign(disp_.size(), Vec3::Zero());
+  s_.assign(disp_.size(), Vec3::Zero());
   for (std::size_t a = 0; a < act_.size(); ++a) {
     const ContactPair& c = pairs[act_[a]];
     const Vec3 g = p[a] * n_[act_[a]];
     disp_[c.i] += mob[c.i] * g;
     if (!c.wall) disp_[c.k] -= mob[c.k] * g;
-    if (coupled_) {
-      s_[c.i] += g;
-      if (!c.wall) s_[c.k] -= g;
-    }
+    s_[c.i] += g;
+    if (!c.wall) s_[c.k] -= g;
   }
-  if (coupled_) coupled_->add(s_, coupled_scale_, disp_, &act_particles_);
-  out.resize(act_.size());
+  coupled_->add(s_, coupled_scale_, disp_, &act_particles_);
   for (std::size_t a = 0; a < act_.size(); ++a) {
     const std::uint32_t e = act_[a];
     const ContactPair& c = pairs[e];
@@ -82,6 +94,17 @@ long ContactDual::solve_cg(const std::vector<ContactPair>& pairs, double rtol) {
     const ContactPair& c = pairs[act_[a]];
     diag_[a] = mob[c.i] + (c.wall ? 0.0 : mob[c.k]) + comp_[act_[a]] + (coupled_ ? crel_[act_[a]] : 0.0);
     r_[a] = rhs_[act_[a]];
+  }
+  if (!coupled_) {  // what apply reads, in the order it reads it; a wall pair's far end is the spare row n
+    const auto spare = static_cast<std::uint32_t>(disp_.size());
+    pdisp_.resize(disp_.size() + 1);
+    pdisp_[spare].setZero();
+    packed_.resize(m);
+    for (std::size_t a = 0; a < m; ++a) {
+      const std::uint32_t e = act_[a];
+      const ContactPair& c = pairs[e];
+      packed_[a] = {n_[e], mob[c.i], c.wall ? 0.0 : mob[c.k], comp_[e], c.i, c.wall ? spare : c.k};
+    }
   }
   auto apply_a = [&](const std::vector<double>& p, std::vector<double>& out) { apply(pairs, p, out); };
   const bool ic0 = precond_ == Preconditioner::incomplete_cholesky ||

@@ -101,6 +101,17 @@ class ContactDual {
   mutable std::vector<double> ic_y_;
   std::vector<std::pair<std::uint32_t, double>> ic_row_;  // scratch: one row of A while it is assembled
   std::vector<Vec3> s_, y_next_, disp_;      // per particle: G q, positions with the new normals, M G q
+  // Without a coupled mobility, apply reads the active pairs from a packed
+  // copy made once per linear solve (normal, both mobilities, compliance
+  // slope, ends; a wall pair's far end is the spare last row of pdisp_, M G q
+  // of that path, with mobility 0): the same products in the same order.
+  struct Packed {
+    Vec3 n;
+    double mob_i, mob_k, comp;
+    std::uint32_t i, k;
+  };
+  std::vector<Packed> packed_;
+  std::vector<Vec3> pdisp_;
   const std::vector<double>* mob_ = nullptr;  // of the current solve
   MobilityCoupling* coupled_ = nullptr;
   double coupled_scale_ = 0;
