@@ -276,13 +276,6 @@ TEST(PairLoop, FlippedSignEvaluatorFailsTheCheck) {
   EXPECT_GT(rel(sd.virial_mag_xz, ref.s.virial_mag_xz, ref.scale.virial_mag_xz), 1e6 * k_tol);
 }
 
-// The vectorised kernel (scene/pair_kernel_simd.cpp, Highway, the best
-// instruction set of this machine) against the scalar loop free_rows on the
-// same rows: each pair's force is the same expression but for 1/r (a refined
-// rsqrt14 on AVX-512, a few ulp off), and the row sums run in another order,
-// so forces and sums agree to round-off; the overlap is a maximum of values
-// that differ by a few ulp. The configurations have
-// rows of every length, so both the vector body and the scalar tail run.
 // The kernel's own loads and stores (AVX2: one 4-wide load and store per
 // partner, which also touch the next sphere's x) against the scalar loop on
 // a list of every pair in range, each row in descending order: partners
@@ -322,6 +315,13 @@ TEST(PairLoop, VectorKernelWithNeighbouringPartnersEqualsTheScalarLoop) {
   EXPECT_LT(std::abs(vector.energy_dipole - scalar.energy_dipole), 1e-12 * std::abs(scalar.energy_dipole));
 }
 
+// The vectorised kernel (scene/pair_kernel_simd.cpp, Highway, the best
+// instruction set of this machine) against the scalar loop free_rows on the
+// same rows: each pair's force is the same expression but for 1/r (a refined
+// rsqrt14 on AVX-512, a few ulp off), and the row sums run in another order,
+// so forces and sums agree to round-off; the overlap is a maximum of values
+// that differ by a few ulp. The configurations have
+// rows of every length, so both the vector body and the scalar tail run.
 TEST(PairLoop, VectorKernelEqualsTheScalarLoop) {
   std::printf("pair kernel target: %s\n", pair_kernel_target());
   for (std::uint64_t seed : {3u, 8u}) {
