@@ -90,21 +90,21 @@ long ContactDual::solve_cg(const std::vector<ContactPair>& pairs, double rtol) {
   const std::vector<double>& mob = *mob_;
   diag_.resize(m);
   r_.resize(m);
-  for (std::size_t a = 0; a < m; ++a) {
-    const ContactPair& c = pairs[act_[a]];
-    diag_[a] = mob[c.i] + (c.wall ? 0.0 : mob[c.k]) + comp_[act_[a]] + (coupled_ ? crel_[act_[a]] : 0.0);
-    r_[a] = rhs_[act_[a]];
-  }
-  if (!coupled_) {  // what apply reads, in the order it reads it; a wall pair's far end is the spare row n
-    const auto spare = static_cast<std::uint32_t>(disp_.size());
+  // Without a coupled mobility, also what apply reads, in the order it reads
+  // it; a wall pair's far end is the spare row n of pdisp_.
+  const auto spare = static_cast<std::uint32_t>(disp_.size());
+  if (!coupled_) {
     pdisp_.resize(disp_.size() + 1);
     pdisp_[spare].setZero();
     packed_.resize(m);
-    for (std::size_t a = 0; a < m; ++a) {
-      const std::uint32_t e = act_[a];
-      const ContactPair& c = pairs[e];
-      packed_[a] = {n_[e], mob[c.i], c.wall ? 0.0 : mob[c.k], comp_[e], c.i, c.wall ? spare : c.k};
-    }
+  }
+  for (std::size_t a = 0; a < m; ++a) {
+    const std::uint32_t e = act_[a];
+    const ContactPair& c = pairs[e];
+    const double mob_k = c.wall ? 0.0 : mob[c.k];
+    diag_[a] = mob[c.i] + mob_k + comp_[e] + (coupled_ ? crel_[e] : 0.0);
+    r_[a] = rhs_[e];
+    if (!coupled_) packed_[a] = {n_[e], mob[c.i], mob_k, comp_[e], c.i, c.wall ? spare : c.k};
   }
   auto apply_a = [&](const std::vector<double>& p, std::vector<double>& out) { apply(pairs, p, out); };
   const bool ic0 = precond_ == Preconditioner::incomplete_cholesky ||
