@@ -24,14 +24,15 @@ ImplicitFluidSystem::ImplicitFluidSystem(const FluidCell& c, double dt, SphImpli
   const auto& rho = c.fluid.rho;
   const auto& pairs = c.pairs.fluid_fluid;
   const auto& wall_pairs = c.pairs.fluid_wall;
-  k_.resize(pairs.size());
+  rows_.resize(pairs.size());
   kw_.resize(wall_pairs.size());
   vdiag_.assign(n, 1.0);
   for (std::size_t e = 0; e < pairs.size(); ++e) {
     const SphPair& pr = pairs[e];
-    k_[e] = -dt * morris_weight(pr.r, c.h, c.mass, effective_viscosity(c), rho[pr.a], rho[pr.b]);
-    vdiag_[pr.a] += k_[e];
-    vdiag_[pr.b] += k_[e];
+    const double k = -dt * morris_weight(pr.r, c.h, c.mass, effective_viscosity(c), rho[pr.a], rho[pr.b]);
+    rows_[e] = {pr.a, pr.b, k, Vec3::Zero()};
+    vdiag_[pr.a] += k;
+    vdiag_[pr.b] += k;
   }
   for (std::size_t e = 0; e < wall_pairs.size(); ++e) {
     kw_[e] = -dt * wall_viscous_weight(c, wall_pairs[e]);
@@ -41,8 +42,7 @@ ImplicitFluidSystem::ImplicitFluidSystem(const FluidCell& c, double dt, SphImpli
   for (std::size_t a = 0; a < n; ++a) diag_[a] = Vec3::Constant(vdiag_[a]);
   if (!pressure_) return;
   const double scale = c.mass * c.density_scale;
-  g_.resize(pairs.size());
-  for (std::size_t e = 0; e < pairs.size(); ++e) g_[e] = scale * kernel_dwdr_over_r(pairs[e].r, c.h) * pairs[e].r_ab;
+  for (std::size_t e = 0; e < pairs.size(); ++e) rows_[e].g = scale * kernel_dwdr_over_r(pairs[e].r, c.h) * pairs[e].r_ab;
   tw_.assign(n, Vec3::Zero());
   d0_.assign(n, 0.0);
   for (const SphPair& pr : wall_pairs) {
@@ -59,25 +59,24 @@ ImplicitFluidSystem::ImplicitFluidSystem(const FluidCell& c, double dt, SphImpli
   // diagonal of D^T Q D: Q_a T_a T_a^T + sum_b Q_b g_ab g_ab^T, T_a the
   // derivative of (D v)_a by v_a (component-wise, for the preconditioner)
   std::vector<Vec3> t(tw_);
-  for (std::size_t e = 0; e < pairs.size(); ++e) {
-    t[pairs[e].a] += g_[e];
-    t[pairs[e].b] -= g_[e];
-    const Vec3 g2 = g_[e].cwiseProduct(g_[e]);
-    diag_[pairs[e].a] += q_[pairs[e].b] * g2;
-    diag_[pairs[e].b] += q_[pairs[e].a] * g2;
+  for (const Row& e : rows_) {
+    t[e.a] += e.g;
+    t[e.b] -= e.g;
+    const Vec3 g2 = e.g.cwiseProduct(e.g);
+    diag_[e.a] += q_[e.b] * g2;
+    diag_[e.b] += q_[e.a] * g2;
   }
   for (std::size_t a = 0; a < n; ++a) diag_[a] += q_[a] * t[a].cwiseProduct(t[a]);
 }
 
 // s = D x (+ d0)
 void ImplicitFluidSystem::divergence(const std::vector<Vec3>& x, bool with_d0, std::vector<double>& s) const {
-  const auto& pairs = c_.pairs.fluid_fluid;
   s.resize(x.size());
   for (std::size_t a = 0; a < x.size(); ++a) s[a] = tw_[a].dot(x[a]) + (with_d0 ? d0_[a] : 0.0);
-  for (std::size_t e = 0; e < pairs.size(); ++e) {
-    const double d = g_[e].dot(x[pairs[e].a] - x[pairs[e].b]);
-    s[pairs[e].a] += d;
-    s[pairs[e].b] += d;
+  for (const Row& e : rows_) {
+    const double d = e.g.dot(x[e.a] - x[e.b]);
+    s[e.a] += d;
+    s[e.b] += d;
   }
 }
 
@@ -97,28 +96,26 @@ void ImplicitFluidSystem::add_pressure(const std::vector<Vec3>& x, bool with_d0,
 
 // s_ *= Q, out += D^T s_
 void ImplicitFluidSystem::scatter_pressure(std::vector<Vec3>& out) const {
-  const auto& pairs = c_.pairs.fluid_fluid;
   const std::size_t n = out.size();
   for (std::size_t a = 0; a < n; ++a) {
     s_[a] *= q_[a];
     out[a] += s_[a] * tw_[a];
   }
-  for (std::size_t e = 0; e < pairs.size(); ++e) {
-    const Vec3 f = (s_[pairs[e].a] + s_[pairs[e].b]) * g_[e];
-    out[pairs[e].a] += f;
-    out[pairs[e].b] -= f;
+  for (const Row& e : rows_) {
+    const Vec3 f = (s_[e.a] + s_[e.b]) * e.g;
+    out[e.a] += f;
+    out[e.b] -= f;
   }
 }
 
 void ImplicitFluidSystem::apply(const std::vector<Vec3>& x, std::vector<Vec3>& out) const {
-  const auto& pairs = c_.pairs.fluid_fluid;
   const std::size_t n = x.size();
   out.resize(n);
   for (std::size_t a = 0; a < n; ++a) out[a] = vdiag_[a] * x[a];
   if (!pressure_) {
-    for (std::size_t e = 0; e < pairs.size(); ++e) {
-      out[pairs[e].a] -= k_[e] * x[pairs[e].b];
-      out[pairs[e].b] -= k_[e] * x[pairs[e].a];
+    for (const Row& e : rows_) {
+      out[e.a] -= e.k * x[e.b];
+      out[e.b] -= e.k * x[e.a];
     }
     return;
   }
@@ -126,13 +123,12 @@ void ImplicitFluidSystem::apply(const std::vector<Vec3>& x, std::vector<Vec3>& o
   // (each sum in the same order as two passes), then the pressure's
   s_.resize(n);
   for (std::size_t a = 0; a < n; ++a) s_[a] = tw_[a].dot(x[a]);
-  for (std::size_t e = 0; e < pairs.size(); ++e) {
-    const std::uint32_t a = pairs[e].a, b = pairs[e].b;
-    out[a] -= k_[e] * x[b];
-    out[b] -= k_[e] * x[a];
-    const double d = g_[e].dot(x[a] - x[b]);
-    s_[a] += d;
-    s_[b] += d;
+  for (const Row& e : rows_) {
+    out[e.a] -= e.k * x[e.b];
+    out[e.b] -= e.k * x[e.a];
+    const double d = e.g.dot(x[e.a] - x[e.b]);
+    s_[e.a] += d;
+    s_[e.b] += d;
   }
   scatter_pressure(out);
 }

@@ -196,16 +196,20 @@ void CoupledModel::update_coupling_pairs() {
     coupling_cache_time_ = time_;
   }
   coupling_pairs_of(coupling_cache_.candidates, solid_, fluid_.fluid.x, cell_.box, fluid_.h, solid_pairs_);
-  solid_pairs_.erase(std::remove_if(solid_pairs_.begin(), solid_pairs_.end(),
-                                    [&](const CouplingPair& q) {
-                                      return q.i >= n && !(half - std::abs(x[mirrored_[q.i - n]].x()) < rc);
-                                    }),
-                     solid_pairs_.end());
+  // The pairs come in index order, the mirrors' (i >= n) last: only that
+  // tail is filtered, and the particles' pairs are its prefix, kept by a
+  // swap once the porosity has read the mirrors.
   const auto real_end = std::partition_point(solid_pairs_.begin(), solid_pairs_.end(),
                                              [n](const CouplingPair& q) { return q.i < n; });
-  pairs_.assign(solid_pairs_.begin(), real_end);
-  const std::vector<CouplingPair>& solid_pairs = solid_pairs_;
-  PorosityField eps = porosity_at_fluid(fluid_.fluid.size(), sphere_volume(p_.radius), solid_pairs);
+  const auto n_real = real_end - solid_pairs_.begin();
+  solid_pairs_.erase(std::remove_if(real_end, solid_pairs_.end(),
+                                    [&](const CouplingPair& q) {
+                                      return !(half - std::abs(x[mirrored_[q.i - n]].x()) < rc);
+                                    }),
+                     solid_pairs_.end());
+  PorosityField eps = porosity_at_fluid(fluid_.fluid.size(), sphere_volume(p_.radius), solid_pairs_);
+  solid_pairs_.resize(static_cast<std::size_t>(n_real));
+  pairs_.swap(solid_pairs_);
   fluid_.fluid.eps = std::move(eps.eps);
   sums_.eps_clamped = eps.clamped;
   const auto [lo, hi] = std::minmax_element(fluid_.fluid.eps.begin(), fluid_.fluid.eps.end());

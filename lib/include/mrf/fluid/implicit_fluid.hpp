@@ -70,8 +70,18 @@ class ImplicitFluidSystem {
   const FluidCell& c_;
   double dt_;
   bool pressure_;
-  std::vector<double> k_, kw_, vdiag_;  // Morris: -dt K per fluid pair, per wall pair; diagonal of I - dt L
-  std::vector<Vec3> g_, tw_, diag_;      // pressure: g_ab per fluid pair, T_a = sum_w g_aw; Jacobi diagonal
+  // Per fluid pair what apply() reads in every CG iteration, packed: its
+  // two indices, -dt K (Morris) and g_ab (pressure; zero without it). A
+  // product streams 40 bytes a pair instead of the 40-byte SphPair plus the
+  // weights from separate arrays (the pair loops are bound by that traffic).
+  struct Row {
+    std::uint32_t a, b;
+    double k;
+    Vec3 g;
+  };
+  std::vector<Row> rows_;
+  std::vector<double> kw_, vdiag_;  // Morris: -dt K per wall pair; diagonal of I - dt L
+  std::vector<Vec3> tw_, diag_;     // pressure: T_a = sum_w g_aw; Jacobi diagonal
   std::vector<double> d0_, q_;           // pressure: d0_a, dt^2 S1 K_a / rho_a^2
   mutable std::vector<double> s_;        // scratch: Q (D x + d0)
 };
