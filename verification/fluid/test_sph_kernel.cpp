@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "mrf/fluid/kernel.hpp"
 #include "mrf/fluid/viscosity.hpp"
@@ -75,6 +76,40 @@ TEST(SphKernel, HoistedKernelEqualsTheFreeFunctionsBitForBit) {
       ASSERT_EQ(w(r), kernel_w(r, h)) << "r/h " << r / h;
       ASSERT_EQ(w.dwdr_over_r(r), kernel_dwdr_over_r(r, h)) << "r/h " << r / h;
     }
+  }
+}
+}  // namespace
+}  // namespace mrf
+
+namespace mrf {
+namespace {
+// kernel_rows (the vector units' kernel of the coupling pairs) is KernelW
+// bit for bit: r^2 on a fine grid from 0 past the support, the support
+// itself and its neighbouring doubles, in a length that leaves a scalar
+// tail; and a changed law is seen (the comparison can fail).
+TEST(SphKernel, VectorRowsEqualTheScalarKernelBitForBit) {
+  for (double h : {1.3e-6, 1.04e-5, 1.3e-5}) {
+    const KernelW k(h);
+    std::vector<double> r2;
+    for (int j = 0; j <= 2203; ++j) r2.push_back(std::pow(1e-3 * j * h, 2));
+    const double edge = std::pow(k_kernel_support * h, 2);
+    for (double e : {std::nextafter(edge, 0.0), edge, std::nextafter(edge, 1.0)}) r2.push_back(e);
+    std::vector<double> w(r2.size()), f(r2.size());
+    kernel_rows(k, r2.data(), r2.size(), w.data(), f.data());
+    int inside = 0;
+    for (std::size_t p = 0; p < r2.size(); ++p) {
+      const double r = std::sqrt(r2[p]);
+      ASSERT_EQ(w[p], k(r)) << "r/h " << r / h;
+      ASSERT_EQ(f[p], k.dwdr_over_r(r)) << "r/h " << r / h;
+      inside += w[p] > 0;
+    }
+    EXPECT_GT(inside, 1900);  // most of the grid lies inside the support
+    KernelW other = k;
+    other.alpha *= 1.0 + 1e-15;  // a law one ulp off differs somewhere
+    kernel_rows(other, r2.data(), r2.size(), w.data(), f.data());
+    bool differs = false;
+    for (std::size_t p = 0; p < r2.size() && !differs; ++p) differs = w[p] != k(std::sqrt(r2[p]));
+    EXPECT_TRUE(differs);
   }
 }
 }  // namespace

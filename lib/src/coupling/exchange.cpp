@@ -87,11 +87,15 @@ void coupling_pairs_of(const std::vector<IndexPair>& candidates, const std::vect
                                 std::to_string(box.ly) + " m, lz " + std::to_string(box.lz) + " m, 2h " +
                                 std::to_string(rc) + " m): a pair would interact through more than two images");
   const MinImageYZ mi(box);
-  // candidates in blocks (in_blocks), the pairs in candidate order
+  // candidates in blocks (in_blocks), the pairs in candidate order. A pair
+  // in range is kept with its separation and r^2 first; the kernel then runs
+  // over all of a block's r^2 at once on the vector units (kernel_rows), and
+  // (dW/dr)/r scales the separation: the same numbers as KernelW per pair.
   in_blocks(candidates.size(), k_coupling_candidates_per_thread, out,
             [&](std::size_t lo, std::size_t hi, std::vector<CouplingPair>& mine) {
               mine.reserve(hi - lo);
-              const KernelW w(h);
+              thread_local std::vector<double> r2s, ws, fs;
+              r2s.clear();
               for (std::size_t c = lo; c < hi; ++c) {
                 const auto [i, a] = candidates[c];
                 const Vec3& xi = dem_x[i];
@@ -99,8 +103,8 @@ void coupling_pairs_of(const std::vector<IndexPair>& candidates, const std::vect
                 const double dx = xi.x() - xa.x(), dx2 = dx * dx;
                 if (dx2 >= rc2) continue;  // x is not periodic: cheap rejection first
                 auto push = [&, i = i, a = a](double ey, double ez, double q2) {
-                  const double r = std::sqrt(q2);
-                  mine.push_back({i, a, w(r), w.dwdr_over_r(r) * Vec3(dx, ey, ez)});
+                  mine.push_back({i, a, 0.0, Vec3(dx, ey, ez)});
+                  r2s.push_back(q2);
                 };
                 const double dy = mi.wrap_y(xi.y() - xa.y()), dz = mi.wrap_z(xi.z() - xa.z());
                 const double r2 = dx2 + dy * dy + dz * dz;
@@ -120,6 +124,14 @@ void coupling_pairs_of(const std::vector<IndexPair>& candidates, const std::vect
                   image(dy, oz);
                   if (y2) image(oy, oz);
                 }
+              }
+              const std::size_t m = r2s.size();
+              ws.resize(m);
+              fs.resize(m);
+              kernel_rows(KernelW(h), r2s.data(), m, ws.data(), fs.data());
+              for (std::size_t p = 0; p < m; ++p) {
+                mine[p].w = ws[p];
+                mine[p].dw *= fs[p];
               }
             });
 }

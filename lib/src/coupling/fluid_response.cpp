@@ -11,12 +11,17 @@ void FluidResponse::set(std::size_t n_dem, const std::vector<CouplingPair>& pair
                         const std::vector<double>& rho, double mass) {
   // Per DEM particle its SPH neighbours in the order of the pairs (pairs
   // come sorted by DEM index, then SPH index, so the periodic images of one
-  // neighbour are adjacent: their weights add).
+  // neighbour are adjacent: their weights add). Rebuilt every step into the
+  // same buffers.
   const std::size_t na = rho.size();
   mass_ = mass;
   a_.clear();
   scatter_.clear();
-  std::vector<std::uint32_t> merged(n_dem + 1, 0);
+  a_.reserve(pairs.size());
+  scatter_.reserve(pairs.size());
+  start_.assign(n_dem + 1, 0);
+  diag_.assign(n_dem, 0.0);
+  rstart_.assign(na + 1, 0);
   std::size_t next = 0;
   for (std::size_t i = 0; i < n_dem; ++i) {
     const std::size_t row = a_.size();
@@ -29,29 +34,25 @@ void FluidResponse::set(std::size_t n_dem, const std::vector<CouplingPair>& pair
         if (a_.size() > row && a_.back() > q.a) throw std::logic_error("FluidResponse::set: pairs not sorted by (i, a)");
         a_.push_back(q.a);
         scatter_.push_back(sc);
+        ++rstart_[q.a + 1];
       }
     }
-    merged[i + 1] = checked_index(a_.size(), "fluid response");
+    start_[i + 1] = checked_index(a_.size(), "fluid response");
+    for (std::size_t e = row; e < a_.size(); ++e) diag_[i] += mass * scatter_[e] * scatter_[e];
   }
-  start_ = std::move(merged);
   // The same entries by SPH particle (CSR over a), so that the scatter is a
   // gather too: both passes run on threads without write conflicts, each
   // sum in a fixed order.
-  rstart_.assign(na + 1, 0);
-  for (std::uint32_t b : a_) ++rstart_[b + 1];
   for (std::size_t b = 0; b < na; ++b) rstart_[b + 1] += rstart_[b];
   rdem_.resize(a_.size());
   rscatter_.resize(a_.size());
-  std::vector<std::uint32_t> fill(rstart_.begin(), rstart_.end() - 1);
+  fill_.assign(rstart_.begin(), rstart_.end() - 1);
   for (std::size_t i = 0; i < n_dem; ++i)
     for (std::uint32_t e = start_[i]; e < start_[i + 1]; ++e) {
-      const std::uint32_t slot = fill[a_[e]]++;
+      const std::uint32_t slot = fill_[a_[e]]++;
       rdem_[slot] = static_cast<std::uint32_t>(i);
       rscatter_[slot] = scatter_[e];
     }
-  diag_.assign(n_dem, 0.0);
-  for (std::size_t i = 0; i < n_dem; ++i)
-    for (std::uint32_t e = start_[i]; e < start_[i + 1]; ++e) diag_[i] += mass * scatter_[e] * scatter_[e];
   dense_.assign(na, 0.0);
 }
 

@@ -11,6 +11,8 @@
 // Gradient convention: grad_a W_ab = r_ab (dW/dr)/r with r_ab = x_a - x_b,
 // so grad_a W_ab = -grad_b W_ab (odd in r_ab).
 #pragma once
+#include <cstddef>
+
 #include "mrf/vec.hpp"
 
 namespace mrf {
@@ -39,6 +41,13 @@ struct KernelW {
     return -5.0 * alpha * t * t * t / (h * h);
   }
 };
+
+// W and (dW/dr)/r at r = sqrt(r2[p]) for n squared distances (m^2), into
+// w[p] and dwdr_over_r[p]: KernelW's expressions on the vector units (one
+// binary, the best instruction set of the machine, fluid/kernel_simd.cpp),
+// equal to KernelW bit for bit (sqrt and division are correctly rounded in
+// every lane, the products keep their order and stay unfused).
+void kernel_rows(const KernelW& k, const double* r2, std::size_t n, double* w, double* dwdr_over_r);
 
 // W(r, h) in 1/m^3; zero for r >= 2h.
 inline double kernel_w(double r, double h) { return KernelW(h)(r); }
