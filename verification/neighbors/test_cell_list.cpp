@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <random>
 
+#include <omp.h>
+
 #include "mrf/neighbors/cell_list.hpp"
 
 namespace mrf {
@@ -54,6 +56,32 @@ TEST_P(CellListVsBruteForce, PairRowsHoldTheSamePairs) {
       flat.emplace_back(i, rows.k[n]);
     }
   EXPECT_EQ(rows.size(), flat.size());
+  EXPECT_EQ(sorted(flat), sorted(brute_force_self_pairs(pts, box, rc)));
+}
+
+// Above the size where the build runs its rows on threads: the rows are
+// the serial build's, entry for entry, for 1, 2 and 3 threads, and hold the
+// brute-force pairs (blocks of uneven length and empty rows included).
+TEST_P(CellListVsBruteForce, PairRowsOnThreadsEqualTheSerialBuild) {
+  const auto [box, rc] = GetParam();
+  const auto pts = random_points(3001, box, 31);
+  const int saved = omp_get_max_threads();
+  std::vector<PairRows> by_threads;
+  for (int t : {1, 2, 3}) {
+    omp_set_num_threads(t);
+    PairRows rows;
+    self_pair_rows(pts, box, rc, rows);
+    by_threads.push_back(rows);
+  }
+  omp_set_num_threads(saved);
+  for (std::size_t t = 1; t < by_threads.size(); ++t) {
+    EXPECT_EQ(by_threads[t].start, by_threads[0].start) << t + 1 << " threads";
+    EXPECT_EQ(by_threads[t].k, by_threads[0].k) << t + 1 << " threads";
+  }
+  std::vector<IndexPair> flat;
+  const PairRows& rows = by_threads[2];
+  for (std::uint32_t i = 0; i < pts.size(); ++i)
+    for (std::uint32_t n = rows.start[i]; n < rows.start[i + 1]; ++n) flat.emplace_back(i, rows.k[n]);
   EXPECT_EQ(sorted(flat), sorted(brute_force_self_pairs(pts, box, rc)));
 }
 

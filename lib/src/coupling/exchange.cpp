@@ -1,8 +1,6 @@
 // Unresolved SPH-DEM coupling kernels, REFERENCE.md §6. See exchange.hpp.
 #include "mrf/coupling/exchange.hpp"
 
-#include <omp.h>
-
 #include <algorithm>
 #include <stdexcept>
 #include <string>
@@ -11,6 +9,7 @@
 #include "mrf/fluid/kernel.hpp"
 #include "mrf/neighbors/cell_list.hpp"
 #include "mrf/neighbors/verlet_list.hpp"
+#include "parallel_blocks.hpp"
 
 namespace mrf {
 
@@ -20,24 +19,6 @@ constexpr std::size_t k_coupling_rows_per_thread = 1000;
 // candidates per thread below which their evaluation stays serial
 constexpr std::size_t k_coupling_candidates_per_thread = 50000;
 
-// body(lo, hi, mine) over [0, n) in contiguous blocks, one per thread when
-// n >= per_thread, each filling its own list; the lists are joined into
-// `out` in block order, so the result is the same whatever the number of
-// threads.
-template <class T, class Body>
-void in_blocks(std::size_t n, std::size_t per_thread, std::vector<T>& out, Body&& body) {
-  const int blocks = n >= per_thread ? std::max(1, omp_get_max_threads()) : 1;
-  std::vector<std::vector<T>> part(static_cast<std::size_t>(blocks));
-#pragma omp parallel for schedule(static, 1) if (blocks > 1)
-  for (int blk = 0; blk < blocks; ++blk) {
-    std::vector<T>& mine = blk == 0 ? out : part[static_cast<std::size_t>(blk)];
-    mine.clear();
-    body(n * static_cast<std::size_t>(blk) / static_cast<std::size_t>(blocks),
-         n * static_cast<std::size_t>(blk + 1) / static_cast<std::size_t>(blocks), mine);
-  }
-  for (int blk = 1; blk < blocks; ++blk)
-    out.insert(out.end(), part[static_cast<std::size_t>(blk)].begin(), part[static_cast<std::size_t>(blk)].end());
-}
 }  // namespace
 
 void coupling_candidates(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x, const Box& box,
@@ -58,7 +39,7 @@ void coupling_candidates(const std::vector<Vec3>& dem_x, const std::vector<Vec3>
   const MinImageYZ mi(box);
   // DEM particles in blocks (in_blocks): the candidates come in the same
   // order whatever the number of threads.
-  in_blocks(dem_x.size(), k_coupling_rows_per_thread, out,
+  detail::in_blocks(dem_x.size(), k_coupling_rows_per_thread, out,
             [&](std::size_t lo, std::size_t hi, std::vector<IndexPair>& mine) {
               for (std::size_t ii = lo; ii < hi; ++ii) {
                 const auto i = static_cast<std::uint32_t>(ii);
@@ -91,7 +72,7 @@ void coupling_pairs_of(const std::vector<IndexPair>& candidates, const std::vect
   // in range is kept with its separation and r^2 first; the kernel then runs
   // over all of a block's r^2 at once on the vector units (kernel_rows), and
   // (dW/dr)/r scales the separation: the same numbers as KernelW per pair.
-  in_blocks(candidates.size(), k_coupling_candidates_per_thread, out,
+  detail::in_blocks(candidates.size(), k_coupling_candidates_per_thread, out,
             [&](std::size_t lo, std::size_t hi, std::vector<CouplingPair>& mine) {
               mine.reserve(hi - lo);
               thread_local std::vector<double> r2s, ws, fs;

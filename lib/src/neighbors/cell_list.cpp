@@ -6,9 +6,13 @@
 #include <stdexcept>
 #include <string>
 
+#include "parallel_blocks.hpp"
+
 namespace mrf {
 
 namespace {
+// spheres per thread below which a list build stays serial
+constexpr std::size_t k_rows_per_thread = 1000;
 int cells_along(double length, double min_cell) {
   return std::max(1, static_cast<int>(std::floor(length / min_cell)));
 }
@@ -96,14 +100,25 @@ void self_pair_rows(const std::vector<Vec3>& pts, const Box& box, double cutoff,
   grid.bin(pts);
   const double rc2 = cutoff * cutoff;
   const MinImageYZ mi(box);
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    const Vec3 xi = pts[i];
-    grid.for_each_candidate(xi, [&](std::uint32_t j) {
-      if (j <= i) return;
-      if (mi.norm2(xi, pts[j]) < rc2) out.k.push_back(j);
-    });
-    out.start[i + 1] = checked_index(out.k.size(), "pair list");
-  }
+  // Rows in blocks on threads (detail::in_blocks): each block's partners in
+  // its own list, row ends counted within the block and shifted to the
+  // joined list after, so the rows are the serial ones whatever the threads.
+  const std::size_t n = pts.size();
+  const std::vector<std::size_t> begin =
+      detail::in_blocks(n, k_rows_per_thread, out.k, [&](std::size_t r0, std::size_t r1, std::vector<std::uint32_t>& mine) {
+        for (std::size_t i = r0; i < r1; ++i) {
+          const Vec3 xi = pts[i];
+          grid.for_each_candidate(xi, [&](std::uint32_t j) {
+            if (j <= i) return;
+            if (mi.norm2(xi, pts[j]) < rc2) mine.push_back(j);
+          });
+          out.start[i + 1] = checked_index(mine.size(), "pair list");
+        }
+      });
+  const std::size_t blocks = begin.size();
+  for (std::size_t b = 1; b < blocks; ++b)
+    for (std::size_t i = n * b / blocks; i < n * (b + 1) / blocks; ++i)
+      out.start[i + 1] = checked_index(out.start[i + 1] + begin[b], "pair list");
 }
 
 std::vector<IndexPair> cross_pairs(const std::vector<Vec3>& a, const std::vector<Vec3>& b,

@@ -1,0 +1,35 @@
+// Deterministic parallel fills of one list (internal to the library).
+#pragma once
+#include <omp.h>
+
+#include <algorithm>
+#include <cstddef>
+#include <vector>
+
+namespace mrf::detail {
+
+// body(lo, hi, mine) over [0, n) in contiguous blocks, one per thread when
+// n >= per_thread, each filling its own list; the lists are joined into
+// `out` in block order, so the result is the same whatever the number of
+// threads. Returns where each block's entries begin in `out` (block b covers
+// [n b / B, n (b + 1) / B) of the range, B the size of the result).
+template <class T, class Body>
+std::vector<std::size_t> in_blocks(std::size_t n, std::size_t per_thread, std::vector<T>& out, Body&& body) {
+  const int blocks = n >= per_thread ? std::max(1, omp_get_max_threads()) : 1;
+  std::vector<std::vector<T>> part(static_cast<std::size_t>(blocks));
+#pragma omp parallel for schedule(static, 1) if (blocks > 1)
+  for (int blk = 0; blk < blocks; ++blk) {
+    std::vector<T>& mine = blk == 0 ? out : part[static_cast<std::size_t>(blk)];
+    mine.clear();
+    body(n * static_cast<std::size_t>(blk) / static_cast<std::size_t>(blocks),
+         n * static_cast<std::size_t>(blk + 1) / static_cast<std::size_t>(blocks), mine);
+  }
+  std::vector<std::size_t> begin(static_cast<std::size_t>(blocks), 0);
+  for (int blk = 1; blk < blocks; ++blk) {
+    begin[static_cast<std::size_t>(blk)] = out.size();
+    out.insert(out.end(), part[static_cast<std::size_t>(blk)].begin(), part[static_cast<std::size_t>(blk)].end());
+  }
+  return begin;
+}
+
+}  // namespace mrf::detail
