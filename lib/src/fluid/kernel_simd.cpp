@@ -17,7 +17,8 @@ namespace mrf {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-void KernelRows(double h, double alpha, const double* r2, std::size_t n, double* w, double* f) {
+void KernelRows(const KernelW& k, const double* r2, std::size_t n, double* w, double* f) {
+  const double h = k.h, alpha = k.alpha;
   const hn::ScalableTag<double> d;
   const std::size_t lanes = hn::Lanes(d);
   const auto vh = hn::Set(d, h), valpha = hn::Set(d, alpha), vm5alpha = hn::Set(d, -5.0 * alpha),
@@ -35,8 +36,6 @@ void KernelRows(double h, double alpha, const double* r2, std::size_t n, double*
     hn::StoreU(hn::IfThenElseZero(inside, wv), d, w + p);
     hn::StoreU(hn::IfThenElseZero(inside, fv), d, f + p);
   }
-  KernelW k(h);
-  k.alpha = alpha;
   for (; p < n; ++p) {
     const double r = std::sqrt(r2[p]);
     w[p] = k(r);
@@ -53,7 +52,7 @@ namespace mrf {
 HWY_EXPORT(KernelRows);
 
 void kernel_rows(const KernelW& k, const double* r2, std::size_t n, double* w, double* dwdr_over_r) {
-  HWY_DYNAMIC_DISPATCH(KernelRows)(k.h, k.alpha, r2, n, w, dwdr_over_r);
+  HWY_DYNAMIC_DISPATCH(KernelRows)(k, r2, n, w, dwdr_over_r);
 }
 }  // namespace mrf
 #endif

@@ -71,9 +71,9 @@ class ImplicitFluidSystem {
   double dt_;
   bool pressure_;
   // Per fluid pair what apply() reads in every CG iteration, packed: its
-  // two indices, -dt K (Morris) and g_ab (pressure; zero without it). A
-  // product streams 40 bytes a pair instead of the 40-byte SphPair plus the
-  // weights from separate arrays (the pair loops are bound by that traffic).
+  // two indices, -dt K (Morris) and g_ab (pressure; zero without it): one
+  // 40-byte stream a product instead of the 40-byte SphPair and the weights
+  // from two more arrays.
   struct Row {
     std::uint32_t a, b;
     double k;
