@@ -8,11 +8,15 @@
 
 namespace mrf::detail {
 
+// Where block `blk` of `blocks` starts in [0, n) (block blk covers
+// [block_bound(n, blk, blocks), block_bound(n, blk + 1, blocks))).
+inline std::size_t block_bound(std::size_t n, std::size_t blk, std::size_t blocks) { return n * blk / blocks; }
+
 // body(lo, hi, mine) over [0, n) in contiguous blocks, one per thread when
 // n >= per_thread, each filling its own list; the lists are joined into
 // `out` in block order, so the result is the same whatever the number of
-// threads. Returns where each block's entries begin in `out` (block b covers
-// [n b / B, n (b + 1) / B) of the range, B the size of the result).
+// threads. Returns where each block's entries begin in `out`, one per block
+// (the blocks' ranges: block_bound).
 template <class T, class Body>
 std::vector<std::size_t> in_blocks(std::size_t n, std::size_t per_thread, std::vector<T>& out, Body&& body) {
   const int blocks = n >= per_thread ? std::max(1, omp_get_max_threads()) : 1;
@@ -21,8 +25,8 @@ std::vector<std::size_t> in_blocks(std::size_t n, std::size_t per_thread, std::v
   for (int blk = 0; blk < blocks; ++blk) {
     std::vector<T>& mine = blk == 0 ? out : part[static_cast<std::size_t>(blk)];
     mine.clear();
-    body(n * static_cast<std::size_t>(blk) / static_cast<std::size_t>(blocks),
-         n * static_cast<std::size_t>(blk + 1) / static_cast<std::size_t>(blocks), mine);
+    const auto b = static_cast<std::size_t>(blk), nb = static_cast<std::size_t>(blocks);
+    body(block_bound(n, b, nb), block_bound(n, b + 1, nb), mine);
   }
   std::vector<std::size_t> begin(static_cast<std::size_t>(blocks), 0);
   for (int blk = 1; blk < blocks; ++blk) {

@@ -105,7 +105,7 @@ TEST(SphKernel, VectorRowsEqualTheScalarKernelBitForBit) {
     }
     EXPECT_GT(inside, 1900);  // most of the grid lies inside the support
     KernelW other = k;
-    other.alpha *= 1.0 + 1e-15;  // a law one ulp off differs somewhere
+    other.alpha *= 1.0 + 1e-15;  // a law a few ulp off differs somewhere
     kernel_rows(other, r2.data(), r2.size(), w.data(), f.data());
     bool differs = false;
     for (std::size_t p = 0; p < r2.size() && !differs; ++p) differs = w[p] != k(std::sqrt(r2[p]));

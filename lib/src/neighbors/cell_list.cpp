@@ -117,7 +117,7 @@ void self_pair_rows(const std::vector<Vec3>& pts, const Box& box, double cutoff,
       });
   const std::size_t blocks = begin.size();
   for (std::size_t b = 1; b < blocks; ++b)
-    for (std::size_t i = n * b / blocks; i < n * (b + 1) / blocks; ++i)
+    for (std::size_t i = detail::block_bound(n, b, blocks); i < detail::block_bound(n, b + 1, blocks); ++i)
       out.start[i + 1] = checked_index(out.start[i + 1] + begin[b], "pair list");
 }
 
