@@ -14,11 +14,13 @@
 // 1/r = inv_r; returns (1 - 3c^2)/r^3 (1/m^3).
 template <class T, class Num>
 inline T dipole_x_law(T pref, T dx, T dy, T dz, T inv_r, T& fx, T& fy, T& fz, Num num) {
+  // Grouped for a short dependency chain (the vector kernel is bound by
+  // its latency): w and 2 w dx do not wait for c^2.
   const T inv_r2 = inv_r * inv_r;
   const T c = dx * inv_r, c2 = c * c;
-  const T s = pref * inv_r2 * inv_r2;                 // pref / r^4
-  const T a = s * (num(1.0) - num(5.0) * c2) * inv_r;  // radial part / r
-  fx = a * dx + num(2.0) * s * c;
+  const T w = (pref * inv_r) * (inv_r2 * inv_r2);  // pref / r^5
+  const T a = w * (num(1.0) - num(5.0) * c2);      // radial part / r
+  fx = a * dx + (num(2.0) * dx) * w;               // + 2 pref c / r^4 along x
   fy = a * dy;
   fz = a * dz;
   return (num(1.0) - num(3.0) * c2) * inv_r2 * inv_r;
