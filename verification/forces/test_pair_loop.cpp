@@ -316,7 +316,7 @@ TEST(PairLoop, VectorKernelWithNeighbouringPartnersEqualsTheScalarLoop) {
 // The vectorised kernel (scene/pair_kernel_simd.cpp, Highway, the best
 // instruction set of this machine) against the scalar loop free_rows on the
 // same rows: each pair's force is the same expression but for 1/r (a refined
-// rsqrt14 on AVX-512, a few ulp off), and the row sums run in another order,
+// rsqrt14 on AVX-512, sqrt(r^2) * (1/r^2) elsewhere: a few ulp off), and the row sums run in another order,
 // so forces and sums agree to round-off; the overlap is a maximum of values
 // that differ by a few ulp. The configurations have
 // rows of every length, so both the vector body and the scalar tail run.

@@ -8,18 +8,33 @@
 //
 // A row's partners are taken a vector at a time: their coordinates gathered
 // from the packed Vec3 array, the laws of forces/ (dipole_x_law,
-// hertz_law_t) evaluated on whole vectors, a pair beyond the range masked
-// out, and the partners' forces gathered, decremented and scattered back (a
-// row's partners are distinct, so lanes never collide). On AVX2, which has
-// no scatter, the partners' coordinates and forces move by 4-wide loads and
-// stores and 4 x 4 transposes instead. The Hertz law runs on
-// max(h, 0), which gives 0 without overlap, and only on vectors with a
+// hertz_law_t) evaluated on whole vectors, and the partners' forces
+// gathered, decremented and scattered back (a row's partners are distinct,
+// so lanes never collide). On AVX2, which has no scatter, the partners'
+// coordinates and forces move by aligned 4-wide loads and stores of padded
+// copies and 4 x 4 transposes instead. A pair beyond the range gets 1/r = 0,
+// so its dipole force is 0. The Hertz law runs only on vectors with a
 // contact in them. The tail of a row shorter than a vector runs the scalar
-// loop's pair (detail::pair_force). The pair forces are the scalar loop's expressions except 1/r
-// (on AVX-512 a refined rsqrt14, a few ulp from 1/sqrt), and the row sums run
-// in another order, so forces and sums agree with free_rows to round-off
-// (PairLoop.VectorKernelEqualsTheScalarLoop in
-// verification/forces/test_pair_loop.cpp).
+// loop's pair (detail::pair_force).
+//
+// The loop is bound by latency, not by arithmetic: each vector's chain runs
+// from the index loads through the wrap, r^2, a square root and a division
+// (about 20 and 13 cycles on Zen 2) to the laws and the stores, and its uops
+// that wait for 1/r fill the scheduler. So (measured on Zen 2, AVX2, side by
+// side in Google Benchmark, PaperPairForces, session 17): 1/r is
+// sqrt(r^2) * (1 / r^2), the two divider operations in parallel (1.08x
+// against 1 / sqrt); one mask on 1/r instead of one per force component
+// (1.10x); the wrap rounds with one instruction (1.04x); and the loop is
+// software-pipelined by one vector, the geometry and 1/r of the next
+// vector issued before the laws of this one (1.40x). Not kept: a
+// single-precision rsqrt refined by two steps (0.7-0.85x: the conversions
+// and the refinement lengthen the chain), pipelining by two vectors (0.9x:
+// registers spill).
+//
+// The pair forces are the scalar loop's expressions except 1/r (a few ulp
+// from 1/sqrt), and the row sums run in another order, so forces and sums
+// agree with free_rows to round-off (PairLoop.VectorKernelEqualsTheScalarLoop
+// in verification/forces/test_pair_loop.cpp).
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "scene/pair_kernel_simd.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
@@ -39,7 +54,8 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 // 1/sqrt(v). On AVX-512 the 14-bit estimate of rsqrt14 refined by two Newton
 // steps, y (3 - v y^2) / 2 (error 2^-56 before rounding, a few ulp after),
-// which costs less than a sqrt and a division; elsewhere 1/sqrt(v).
+// which costs less than a sqrt and a division; elsewhere sqrt(v) * (1/v),
+// whose two operations run side by side (1/sqrt(v) chains them).
 template <class V>
 HWY_INLINE V inverse_sqrt(V v) {
 #if HWY_TARGET == HWY_AVX3
@@ -107,12 +123,11 @@ void FreeRowsOf(const DemPairLaws<Dipole, HertzPair>& laws, const Box& box, cons
 #if HWY_TARGET == HWY_AVX2
   // AVX2 has no scatter (Highway stores lane by lane) and Zen 2's gathers
   // are slow, so the partners' coordinates and forces move by aligned
-  // 4-wide loads and stores from padded copies, (x, y, z, 0) per sphere,
-  // and 4 x 4 transposes. A 4-wide access to the packed Vec3 array would
-  // overlap the next sphere, and a load that partly overlaps a store still
-  // in flight (partners next to each other in memory) cannot be forwarded
-  // and waits for it: measured 1.3x slower. The partners' forces collect
-  // in fp, which is added to f at the end.
+  // 4-wide loads and stores of padded copies, (x, y, z, 0) per sphere, and
+  // 4 x 4 transposes. (A 4-wide access to the packed Vec3 array overlaps
+  // the next sphere; such a load cannot take its data from a store to that
+  // sphere still in flight. The padded copies measured 1.015x.) The
+  // partners' forces collect in fp, which is added to f at the end.
   struct alignas(32) Padded {
     double v[4];
   };
