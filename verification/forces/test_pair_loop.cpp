@@ -277,12 +277,13 @@ TEST(PairLoop, FlippedSignEvaluatorFailsTheCheck) {
 }
 
 // The kernel's own loads and stores (AVX2: one 4-wide load and store per
-// partner, which also touch the next sphere's x) against the scalar loop on
-// a list of every pair in range, each row in descending order: partners
-// that are neighbours in memory share a vector in most rows, k + 1 before k,
-// so a lane that stored the next sphere's x from before its neighbour's
-// update would lose that update (a whole pair force, not round-off); and
-// the last sphere, which has no next one, is a partner in many rows.
+// partner in the padded copies) against the scalar loop on a list of every
+// pair in range, each row in descending order: partners that are
+// neighbours in memory share a vector in most rows, k + 1 before k, so a
+// lane whose store overlapped its neighbour's would lose that update (a
+// whole pair force, not round-off); and the last sphere, next to the
+// padded copies' far dummy that fills a row's last vector, is a partner in
+// many rows.
 TEST(PairLoop, VectorKernelWithNeighbouringPartnersEqualsTheScalarLoop) {
   Case s = random_case(5, 1e6, false);
   const std::size_t n = s.cell.free.size();

@@ -6,16 +6,13 @@
 // has chosen at the first call (HWY_DYNAMIC_DISPATCH), so one binary runs at
 // full width everywhere.
 //
-// A row's partners are taken a vector at a time: their coordinates gathered
-// from the packed Vec3 array, the laws of forces/ (dipole_x_law,
-// hertz_law_t) evaluated on whole vectors, and the partners' forces
-// gathered, decremented and scattered back (a row's partners are distinct,
-// so lanes never collide). On AVX2, which has no scatter, the partners'
-// coordinates and forces move by aligned 4-wide loads and stores of padded
-// copies and 4 x 4 transposes instead. A pair beyond the range gets 1/r = 0,
-// so its dipole force is 0. The Hertz law runs only on vectors with a
-// contact in them. The tail of a row shorter than a vector runs the scalar
-// loop's pair (detail::pair_force).
+// A row's partners are taken a vector at a time from padded copies of the
+// coordinates: loaded and transposed on AVX2, gathered elsewhere; the laws
+// of forces/ (dipole_x_law, hertz_law_t) evaluated on whole vectors; and
+// the partners' forces decremented in a padded buffer (a row's partners are
+// distinct, so lanes never collide). A pair beyond the range gets 1/r = 0,
+// so its dipole force is 0; the lanes past a row's end take a far dummy
+// partner. The Hertz law runs only on vectors with a contact in them.
 //
 // The loop is bound by latency, not by arithmetic: each vector's chain runs
 // from the index loads through the wrap, r^2, a square root and a division
@@ -26,10 +23,12 @@
 // against 1 / sqrt); one mask on 1/r instead of one per force component
 // (1.10x); the wrap rounds with one instruction (1.04x); and the loop is
 // software-pipelined by one vector, the geometry and 1/r of the next
-// vector issued before the laws of this one (1.40x). Not kept: a
+// vector issued before the laws of this one (1.40x); a row's last vector
+// padded with the dummy instead of a scalar tail (1.03x). Not kept: a
 // single-precision rsqrt refined by two steps (0.7-0.85x: the conversions
 // and the refinement lengthen the chain), pipelining by two vectors (0.9x:
-// registers spill).
+// registers spill), one pipeline across rows (0.78x: the row of each
+// vector and its partners carried along).
 //
 // The pair forces are the scalar loop's expressions except 1/r (a few ulp
 // from 1/sqrt), and the row sums run in another order, so forces and sums
@@ -118,89 +117,89 @@ void FreeRowsOf(const DemPairLaws<Dipole, HertzPair>& laws, const Box& box, cons
   const auto vrange2 = hn::Set(d, range2), vcontact2 = hn::Set(d, contact2), zero = hn::Zero(d);
   const auto ly = hn::Set(d, mi.ly), inv_ly = hn::Set(d, mi.inv_ly), lz = hn::Set(d, mi.lz), inv_lz = hn::Set(d, mi.inv_lz);
   const std::uint32_t* ks = rows.k.data();
-  const double* xs = x.data()->data();  // Vec3: three packed doubles
   double* fs = f.data()->data();
-#if HWY_TARGET == HWY_AVX2
-  // AVX2 has no scatter (Highway stores lane by lane) and Zen 2's gathers
-  // are slow, so the partners' coordinates and forces move by aligned
-  // 4-wide loads and stores of padded copies, (x, y, z, 0) per sphere, and
-  // 4 x 4 transposes. (A 4-wide access to the packed Vec3 array overlaps
-  // the next sphere; such a load cannot take its data from a store to that
-  // sphere still in flight. The padded copies measured 1.015x.) The
-  // partners' forces collect in fp, which is added to f at the end.
+  // Padded copies, (x, y, z, 0) per sphere. On AVX2, which has no scatter
+  // (Highway stores lane by lane) and whose gathers are slow on Zen 2, the
+  // partners' coordinates and forces move by aligned 4-wide loads and
+  // stores of them and 4 x 4 transposes (a 4-wide access to the packed Vec3
+  // array would overlap the next sphere, and such a load cannot take its
+  // data from a store to that sphere still in flight); elsewhere by gathers
+  // and scatters. The partners' forces collect in fp, added to f at the
+  // end. One more sphere, far beyond every range (its r^2 is finite,
+  // 1e200 m^2), fills the lanes past the end of a row, where 1/r = 0 gives
+  // it no force: a row's last vector needs no scalar tail.
   struct alignas(32) Padded {
     double v[4];
   };
   thread_local std::vector<Padded> xp, fp;
   const std::size_t n_free = x.size();
-  xp.resize(n_free);
-  fp.assign(n_free, Padded{});
-  for (std::size_t k = 0; k < n_free; ++k) xp[k] = Padded{{xs[3 * k], xs[3 * k + 1], xs[3 * k + 2], 0.0}};
+  const auto dummy = static_cast<std::uint32_t>(n_free);
+  xp.resize(n_free + 1);
+  fp.assign(n_free + 1, Padded{});
+  for (std::size_t k = 0; k < n_free; ++k) xp[k] = Padded{{x[k].x(), x[k].y(), x[k].z(), 0.0}};
+  xp[n_free] = Padded{{1e100, 0.0, 0.0, 0.0}};
   const double* xa = xp.data()->v;
   double* fa = fp.data()->v;
-#endif
   struct Geometry {  // of one vector of pairs
     V dx, dy, dz, r2, inv_r;
     hn::Mask<D> in_range;
   };
-  detail::PairTally s;
-  s.max_h = out.max_overlap;
+  constexpr std::size_t k_max_lanes = 8;  // AVX-512's doubles
+  std::uint32_t tail_k[k_max_lanes];      // a row's last vector: its partners, then the dummy
   auto vir_mag = zero, e_dip = zero, vir_con = zero, e_hertz = zero, max_h = zero;
   for (std::size_t i = row_begin; i < row_end; ++i) {
-    const double xi = xs[3 * i], yi = xs[3 * i + 1], zi = xs[3 * i + 2];
-    const auto vxi = hn::Set(d, xi), vyi = hn::Set(d, yi), vzi = hn::Set(d, zi);
+    const auto vxi = hn::Set(d, xa[4 * i]), vyi = hn::Set(d, xa[4 * i + 1]), vzi = hn::Set(d, xa[4 * i + 2]);
     auto fx = zero, fy = zero, fz = zero;
     std::size_t n = rows.start[i];
     const std::size_t end = rows.start[i + 1];
+    // the partners of the vector from entry m
+    const auto partners = [&](std::size_t m) -> const std::uint32_t* {
+      if (m + lanes <= end) return ks + m;
+      for (std::size_t l = 0; l < lanes; ++l) tail_k[l] = m + l < end ? ks[m + l] : dummy;
+      return tail_k;
+    };
     // Software-pipelined by one vector: the geometry and 1/r of the next
     // vector are issued before the laws of this one, so the long latency
     // of the square root and the division overlaps the laws' work instead
     // of filling the scheduler with uops that wait for it.
     const auto geometry = [&](std::size_t m) {
-#if HWY_TARGET != HWY_AVX2
-      const auto kk = hn::BitCast(di, hn::PromoteTo(du64, hn::LoadU(du, ks + m)));
-      const auto k3 = hn::Add(hn::Add(kk, kk), kk);  // 3 k: x of partner k
-#endif
+      const std::uint32_t* k = partners(m);
 #if HWY_TARGET == HWY_AVX2
-      const __m256d q0 = _mm256_load_pd(xa + 4 * std::size_t{ks[m]}),
-                    q1 = _mm256_load_pd(xa + 4 * std::size_t{ks[m + 1]}),
-                    q2 = _mm256_load_pd(xa + 4 * std::size_t{ks[m + 2]}),
-                    q3 = _mm256_load_pd(xa + 4 * std::size_t{ks[m + 3]});
+      const __m256d q0 = _mm256_load_pd(xa + 4 * std::size_t{k[0]}), q1 = _mm256_load_pd(xa + 4 * std::size_t{k[1]}),
+                    q2 = _mm256_load_pd(xa + 4 * std::size_t{k[2]}), q3 = _mm256_load_pd(xa + 4 * std::size_t{k[3]});
       const __m256d t0 = _mm256_unpacklo_pd(q0, q1), t1 = _mm256_unpackhi_pd(q0, q1);  // x0 x1 z0 z1, y0 y1 0 0
       const __m256d t2 = _mm256_unpacklo_pd(q2, q3), t3 = _mm256_unpackhi_pd(q2, q3);
       const V px{_mm256_permute2f128_pd(t0, t2, 0x20)}, py{_mm256_permute2f128_pd(t1, t3, 0x20)},
           pz{_mm256_permute2f128_pd(t0, t2, 0x31)};
 #else
-      const auto px = hn::GatherIndex(d, xs, k3), py = hn::GatherIndex(d, xs + 1, k3),
-                 pz = hn::GatherIndex(d, xs + 2, k3);
+      const auto k4 = hn::ShiftLeft<2>(hn::BitCast(di, hn::PromoteTo(du64, hn::LoadU(du, k))));  // x of k in xp
+      const auto px = hn::GatherIndex(d, xa, k4), py = hn::GatherIndex(d, xa + 1, k4),
+                 pz = hn::GatherIndex(d, xa + 2, k4);
 #endif
       Geometry g;
       g.dx = hn::Sub(vxi, px);
-      auto dy = hn::Sub(vyi, py);
-      auto dz = hn::Sub(vzi, pz);
+      const auto dy = hn::Sub(vyi, py), dz = hn::Sub(vzi, pz);
       // MinImageYZ's wrap; Round is its round_nearest (to even) in one instruction
-      dy = hn::NegMulAdd(ly, hn::Round(hn::Mul(dy, inv_ly)), dy);
-      dz = hn::NegMulAdd(lz, hn::Round(hn::Mul(dz, inv_lz)), dz);
-      g.r2 = hn::Add(hn::Add(hn::Mul(g.dx, g.dx), hn::Mul(dy, dy)), hn::Mul(dz, dz));
+      g.dy = hn::NegMulAdd(ly, hn::Round(hn::Mul(dy, inv_ly)), dy);
+      g.dz = hn::NegMulAdd(lz, hn::Round(hn::Mul(dz, inv_lz)), dz);
+      g.r2 = hn::Add(hn::Add(hn::Mul(g.dx, g.dx), hn::Mul(g.dy, g.dy)), hn::Mul(g.dz, g.dz));
       // A pair beyond the range gets 1/r = 0, which makes each dipole law's
       // force 0; its energy and its Hertz overlap are masked.
       g.in_range = hn::Lt(g.r2, vrange2);
       g.inv_r = hn::IfThenElseZero(g.in_range, inverse_sqrt(g.r2));
-      g.dy = dy, g.dz = dz;
       return g;
     };
-    if (n + lanes <= end) {
-      Geometry g = geometry(n);
-      for (;;) {
-        const std::size_t next = n + lanes;
-        const bool more = next + lanes <= end;
-        Geometry gn;
-        if (more) gn = geometry(next);
-        const V dx = g.dx, dy = g.dy, dz = g.dz, r2 = g.r2, inv_r = g.inv_r;
-        const auto in_range = g.in_range;
+    if (n == end) continue;
+    Geometry g = geometry(n);
+    for (;;) {
+      const std::size_t next = n + lanes;
+      const bool more = next < end;
+      Geometry gn;
+      if (more) gn = geometry(next);
+      const V dx = g.dx, dy = g.dy, dz = g.dz, r2 = g.r2, inv_r = g.inv_r;
       V gx, gy, gz;
       const auto ed = vdipole.eval(dx, dy, dz, r2, inv_r, gx, gy, gz, num);
-      e_dip = hn::Add(e_dip, hn::IfThenElseZero(in_range, ed));
+      e_dip = hn::Add(e_dip, hn::IfThenElseZero(g.in_range, ed));
       vir_mag = hn::Add(vir_mag, hn::Mul(dx, gz));
       const auto in_contact = hn::Lt(r2, vcontact2);
       if (!hn::AllFalse(d, in_contact)) {  // contacts are rare: most vectors skip the Hertz law
@@ -216,6 +215,7 @@ void FreeRowsOf(const DemPairLaws<Dipole, HertzPair>& laws, const Box& box, cons
         gz = hn::Add(gz, hn::Mul(f_over_r, dz));
       }
       fx = hn::Add(fx, gx), fy = hn::Add(fy, gy), fz = hn::Add(fz, gz);
+      const std::uint32_t* k = partners(n);
 #if HWY_TARGET == HWY_AVX2
       {  // the transpose back: (gx, gy, gz, 0) per partner, subtracted from its row of fp
         const __m256d zero4 = _mm256_setzero_pd();
@@ -224,43 +224,32 @@ void FreeRowsOf(const DemPairLaws<Dipole, HertzPair>& laws, const Box& box, cons
         const __m256d g4[4] = {_mm256_permute2f128_pd(u0, u2, 0x20), _mm256_permute2f128_pd(u1, u3, 0x20),
                                _mm256_permute2f128_pd(u0, u2, 0x31), _mm256_permute2f128_pd(u1, u3, 0x31)};
         for (std::size_t l = 0; l < 4; ++l) {
-          double* fk = fa + 4 * std::size_t{ks[n + l]};
+          double* fk = fa + 4 * std::size_t{k[l]};
           _mm256_store_pd(fk, _mm256_sub_pd(_mm256_load_pd(fk), g4[l]));
         }
       }
 #else
-      const auto kk = hn::BitCast(di, hn::PromoteTo(du64, hn::LoadU(du, ks + n)));
-      const auto k3 = hn::Add(hn::Add(kk, kk), kk);
-      hn::ScatterIndex(hn::Sub(hn::GatherIndex(d, fs, k3), gx), d, fs, k3);
-      hn::ScatterIndex(hn::Sub(hn::GatherIndex(d, fs + 1, k3), gy), d, fs + 1, k3);
-      hn::ScatterIndex(hn::Sub(hn::GatherIndex(d, fs + 2, k3), gz), d, fs + 2, k3);
-#endif
-        n = next;
-        if (!more) break;
-        g = gn;
+      {  // lanes of the dummy write the same 0 - 0 to the same place
+        const auto k4 = hn::ShiftLeft<2>(hn::BitCast(di, hn::PromoteTo(du64, hn::LoadU(du, k))));
+        hn::ScatterIndex(hn::Sub(hn::GatherIndex(d, fa, k4), gx), d, fa, k4);
+        hn::ScatterIndex(hn::Sub(hn::GatherIndex(d, fa + 1, k4), gy), d, fa + 1, k4);
+        hn::ScatterIndex(hn::Sub(hn::GatherIndex(d, fa + 2, k4), gz), d, fa + 2, k4);
       }
-    }
-    double sx = hn::GetLane(hn::SumOfLanes(d, fx)), sy = hn::GetLane(hn::SumOfLanes(d, fy)),
-           sz = hn::GetLane(hn::SumOfLanes(d, fz));
-    for (; n < end; ++n) {  // the tail: free_rows's pair on doubles
-      const std::size_t k = 3 * static_cast<std::size_t>(ks[n]);
-      const double dx = xi - xs[k], dy = mi.wrap_y(yi - xs[k + 1]), dz = mi.wrap_z(zi - xs[k + 2]);
-      const double r2 = dx * dx + dy * dy + dz * dz;
-      if (r2 >= range2) continue;
-      const Vec3 g = detail::pair_force<true, false>(dipole, laws.contact, rc2, contact2, dx, dy, dz, r2, s);
-      sx += g.x(), sy += g.y(), sz += g.z();
-      fs[k] -= g.x(), fs[k + 1] -= g.y(), fs[k + 2] -= g.z();
-    }
-    fs[3 * i] += sx, fs[3 * i + 1] += sy, fs[3 * i + 2] += sz;
-  }
-#if HWY_TARGET == HWY_AVX2
-  for (std::size_t k = 0; k < n_free; ++k) fs[3 * k] += fa[4 * k], fs[3 * k + 1] += fa[4 * k + 1], fs[3 * k + 2] += fa[4 * k + 2];
 #endif
-  out.virial_mag_xz += s.vir_mag + hn::GetLane(hn::SumOfLanes(d, vir_mag));
-  out.energy_dipole += dipole.energy_scale() * (s.e_dip + hn::GetLane(hn::SumOfLanes(d, e_dip)));
-  out.virial_con_xz += s.vir_con + hn::GetLane(hn::SumOfLanes(d, vir_con));
-  out.energy_hertz += s.e_hertz + hn::GetLane(hn::SumOfLanes(d, e_hertz));
-  out.max_overlap = std::max(s.max_h, hn::GetLane(hn::MaxOfLanes(d, max_h)));
+      if (!more) break;
+      n = next;
+      g = gn;
+    }
+    fs[3 * i] += hn::GetLane(hn::SumOfLanes(d, fx));
+    fs[3 * i + 1] += hn::GetLane(hn::SumOfLanes(d, fy));
+    fs[3 * i + 2] += hn::GetLane(hn::SumOfLanes(d, fz));
+  }
+  for (std::size_t k = 0; k < n_free; ++k) fs[3 * k] += fa[4 * k], fs[3 * k + 1] += fa[4 * k + 1], fs[3 * k + 2] += fa[4 * k + 2];
+  out.virial_mag_xz += hn::GetLane(hn::SumOfLanes(d, vir_mag));
+  out.energy_dipole += laws.dipole.energy_scale() * hn::GetLane(hn::SumOfLanes(d, e_dip));
+  out.virial_con_xz += hn::GetLane(hn::SumOfLanes(d, vir_con));
+  out.energy_hertz += hn::GetLane(hn::SumOfLanes(d, e_hertz));
+  out.max_overlap = std::max(out.max_overlap, hn::GetLane(hn::MaxOfLanes(d, max_h)));
 }
 
 void FreeRows(const DemPairLaws<>& laws, const Box& box, const std::vector<Vec3>& x, const PairRows& rows,
