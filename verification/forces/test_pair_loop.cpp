@@ -7,6 +7,7 @@
 // hertz_energy (Eq. 2). The same loop run with a sign-flipped evaluator fails
 // the same check by many orders of magnitude.
 #include <gtest/gtest.h>
+#include <hwy/targets.h>
 #include <omp.h>
 
 #include <algorithm>
@@ -365,6 +366,37 @@ TEST(PairLoop, VectorKernelEqualsTheScalarLoop) {
     for (std::size_t i = 0; i < n; ++i) moved = std::max(moved, (f_missing[i] - f_scalar[i]).norm() / ref.f_scale[i]);
     EXPECT_GT(moved, 1e-6);
   }
+}
+
+// Every instruction set the kernel was compiled for that this machine runs
+// (here AVX2, SSE4, SSSE3; AVX-512 where the CPU has it), chosen in turn
+// through Highway's test mock: each has its own loads, stores, 1/r and
+// masks, and only the best one runs in a scene.
+TEST(PairLoop, EveryCompiledTargetOfTheVectorKernelEqualsTheScalarLoop) {
+  Case s = random_case(3, 1e6, false);
+  const Reference ref = brute_force(s);
+  const DemPairLaws<> laws = dem_pair_laws(s.p);
+  const std::size_t n = s.cell.free.size(), rows = s.lists.ff.rows();
+  std::vector<Vec3> f_scalar(n, Vec3::Zero());
+  PairSums scalar;
+  detail::free_rows<true, false>(laws, s.cell.box, s.cell.free.x, s.lists.ff, 0, rows, f_scalar, scalar);
+  const std::vector<int64_t> targets = hwy::SupportedAndGeneratedTargets();
+  EXPECT_GE(targets.size(), 2u);
+  for (const int64_t target : targets) {
+    hwy::SetSupportedTargetsForTest(target);
+    EXPECT_STREQ(pair_kernel_target(), hwy::TargetName(target));
+    std::printf("pair kernel target: %s\n", pair_kernel_target());
+    std::vector<Vec3> f_vector(n, Vec3::Zero());
+    PairSums vector;
+    detail::free_rows_simd(laws, s.cell.box, s.cell.free.x, s.lists.ff, 0, rows, f_vector, vector);
+    double worst = 0;
+    for (std::size_t i = 0; i < n; ++i) worst = std::max(worst, (f_vector[i] - f_scalar[i]).norm() / ref.f_scale[i]);
+    EXPECT_LT(worst, 1e-14) << hwy::TargetName(target);
+    EXPECT_LT(rel(vector.energy_dipole, scalar.energy_dipole, ref.scale.energy_dipole), 1e-14) << hwy::TargetName(target);
+    EXPECT_LT(rel(vector.virial_mag_xz, scalar.virial_mag_xz, ref.scale.virial_mag_xz), 1e-14) << hwy::TargetName(target);
+    EXPECT_NEAR(vector.max_overlap, scalar.max_overlap, 1e-12 * R) << hwy::TargetName(target);
+  }
+  hwy::SetSupportedTargetsForTest(0);  // back to the best target
 }
 
 }  // namespace
