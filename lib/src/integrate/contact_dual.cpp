@@ -250,16 +250,26 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
       crel_[c] = coupled_scale_ * std::max(0.0, v);
     }
   }
-  // Warm start: the Hertz forces at x_start, along its normals.
+  // Warm start: the Hertz forces at x_start, along its normals. The normal
+  // of a pair without force is never read (every product skips a zero
+  // force, and an inactive pair's is set before it becomes active), so an
+  // open pair costs no square root or division here or below: most
+  // candidates are open.
+  const double two_r2 = two_r * two_r;
   for (std::size_t c = 0; c < np; ++c) {
     const Vec3 r = pair_vector(pairs[c], x_start, walls_start, mi);
-    const double rn = r.norm();
-    n_[c] = r / rn;
+    const double r2 = r.squaredNorm();
+    if (r2 >= two_r2) {
+      lambda_[c] = 0.0;
+      continue;
+    }
+    const double rn = std::sqrt(r2);
+    n_[c] = r * (1.0 / rn);
     lambda_[c] = hertz_force(two_r - rn, hertz_k);
   }
   y = b;
   move(pairs, lambda_, false, y);
-  const double k23 = std::cbrt(hertz_k * hertz_k);  // k^{2/3}
+  const double inv_k23 = 1.0 / std::cbrt(hertz_k * hertz_k);  // k^{-2/3}
   // lambda += t d on the active set (projected on lambda >= 0), y moved by
   // the change along the current normals
   auto update = [&](double t, const std::vector<double>& d, std::vector<Vec3>& y_out) {
@@ -281,10 +291,11 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
     for (std::size_t c = 0; c < np; ++c) {
       const ContactPair& pc = pairs[c];
       const Vec3 r = pair_vector(pc, y, walls, mi);
-      const double rn = r.norm(), h = two_r - rn;
-      n_[c] = r / rn;
-      if (lambda_[c] <= 0 && h <= 0) continue;  // open and staying open
-      const double h_lambda = std::cbrt(lambda_[c] * lambda_[c]) / k23;  // (lambda/k)^{2/3}
+      const double r2 = r.squaredNorm();
+      if (lambda_[c] <= 0 && r2 >= two_r2) continue;  // open and staying open
+      const double rn = std::sqrt(r2), h = two_r - rn;
+      n_[c] = r * (1.0 / rn);
+      const double h_lambda = std::cbrt(lambda_[c] * lambda_[c]) * inv_k23;  // (lambda/k)^{2/3}
       const double phi = h - h_lambda;  // the Hertz law's residual as an overlap
       rhs_[c] = phi;
       // Compliance slope: of the current force, or for a contact closing
