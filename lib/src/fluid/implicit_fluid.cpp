@@ -10,6 +10,38 @@
 
 namespace mrf {
 
+namespace {
+// A pass over the rows (a ascending in runs, b != a) that adds into out[a]
+// and out[b]: out[a] is held in registers over a run of rows with the same
+// a instead of loaded and stored per row (each store the next row's load
+// waits for). No row of a's run touches out[a] through b, so every sum
+// takes its terms in the same order as the plain loop, bit for bit.
+// `edge(a, load)` loads or stores any further per-a accumulator the same way.
+template <class Rows, class Body, class Edge>
+void by_rows(const Rows& rows, std::vector<Vec3>& out, Body body, Edge edge) {
+  if (rows.empty()) return;
+  std::uint32_t cur = rows.front().a;
+  Vec3 out_a = out[cur];
+  edge(cur, true);
+  for (const auto& e : rows) {
+    if (e.a != cur) {
+      out[cur] = out_a;
+      edge(cur, false);
+      cur = e.a;
+      out_a = out[cur];
+      edge(cur, true);
+    }
+    body(e, out_a);
+  }
+  out[cur] = out_a;
+  edge(cur, false);
+}
+template <class Rows, class Body>
+void by_rows(const Rows& rows, std::vector<Vec3>& out, Body body) {
+  by_rows(rows, out, body, [](std::uint32_t, bool) {});
+}
+}  // namespace
+
 const char* to_string(SphImplicit s) {
   switch (s) {
     case SphImplicit::none: return "explicit";
@@ -101,11 +133,11 @@ void ImplicitFluidSystem::scatter_pressure(std::vector<Vec3>& out) const {
     s_[a] *= q_[a];
     out[a] += s_[a] * tw_[a];
   }
-  for (const Row& e : rows_) {
+  by_rows(rows_, out, [&](const Row& e, Vec3& out_a) {
     const Vec3 f = (s_[e.a] + s_[e.b]) * e.g;
-    out[e.a] += f;
+    out_a += f;
     out[e.b] -= f;
-  }
+  });
 }
 
 void ImplicitFluidSystem::apply(const std::vector<Vec3>& x, std::vector<Vec3>& out) const {
@@ -113,23 +145,32 @@ void ImplicitFluidSystem::apply(const std::vector<Vec3>& x, std::vector<Vec3>& o
   out.resize(n);
   for (std::size_t a = 0; a < n; ++a) out[a] = vdiag_[a] * x[a];
   if (!pressure_) {
-    for (const Row& e : rows_) {
-      out[e.a] -= e.k * x[e.b];
+    by_rows(rows_, out, [&](const Row& e, Vec3& out_a) {
+      out_a -= e.k * x[e.b];
       out[e.b] -= e.k * x[e.a];
-    }
+    });
     return;
   }
   // the viscous product and the divergence D x in one pass over the pairs
   // (each sum in the same order as two passes), then the pressure's
   s_.resize(n);
   for (std::size_t a = 0; a < n; ++a) s_[a] = tw_[a].dot(x[a]);
-  for (const Row& e : rows_) {
-    out[e.a] -= e.k * x[e.b];
-    out[e.b] -= e.k * x[e.a];
-    const double d = e.g.dot(x[e.a] - x[e.b]);
-    s_[e.a] += d;
-    s_[e.b] += d;
-  }
+  double s_a = 0;
+  by_rows(
+      rows_, out,
+      [&](const Row& e, Vec3& out_a) {
+        out_a -= e.k * x[e.b];
+        out[e.b] -= e.k * x[e.a];
+        const double d = e.g.dot(x[e.a] - x[e.b]);
+        s_a += d;
+        s_[e.b] += d;
+      },
+      [&](std::uint32_t a, bool load) {
+        if (load)
+          s_a = s_[a];
+        else
+          s_[a] = s_a;
+      });
   scatter_pressure(out);
 }
 
