@@ -5,6 +5,7 @@
 // stresses agree within N (gap/2) force_tol / V (static equilibrium); a
 // minimisation that cannot converge stops the run with a NumericalError.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <chrono>
 #include <cmath>
@@ -60,6 +61,17 @@ TEST(QuasistaticHertz, PairRelaxesToClosedFormOverlap) {
     std::printf("  tol %.0e F0: h = %.9e m, h* = %.9e m, |h-h*| = %.2e m (bound %.2e), %ld iterations\n", tol, h,
                 h_star, std::abs(h - h_star), bound, r.iterations);
   }
+}
+
+// numerics.threads holds for the driver as for `mrf run` (it once did not:
+// every quasi-static run took all cores, on a machine shared with sweeps).
+TEST(Quasistatic, TakesTheScenesThreadCount) {
+  const int before = omp_get_max_threads();
+  for (int threads : {3, 1}) {
+    (void)quasistatic_run(test::scene({"numerics.threads=" + std::to_string(threads)}), QuasistaticOptions{});
+    EXPECT_EQ(omp_get_max_threads(), threads);
+  }
+  omp_set_num_threads(before);
 }
 
 QuasistaticOptions smoke_options() {

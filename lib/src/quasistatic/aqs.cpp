@@ -286,6 +286,7 @@ QuasistaticRun quasistatic_run(const LoadedScene& scene, const QuasistaticOption
     throw InputError("particles.magnetization", format_short(c.magnetization) + " A/m", scene.locate("particles.magnetization"),
                      "quasi-static shear needs magnetic particles (its force tolerance is relative to the dipole "
                      "contact force)");
+  use_scene_threads(c);  // numerics.threads, as mrf run
   QuasistaticOptions opt = o;
   if (!opt.strain) opt.strain = c.strain;
   if (!opt.warmup_strain) opt.warmup_strain = c.warmup_strain;

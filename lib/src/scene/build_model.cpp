@@ -1,6 +1,5 @@
 #include "mrf/scene/build_model.hpp"
 
-#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -289,7 +288,7 @@ BuiltModel build_fluid_only(const LoadedScene& scene, bool quiet) {
 
 BuiltModel build_model(const LoadedScene& scene, bool quiet) {
   const SceneConfig& c = scene.config;
-  if (c.threads > 0) omp_set_num_threads(c.threads);
+  use_scene_threads(c);
   if (c.model != ModelId::dem_stokes && c.volume_fraction == 0) return build_fluid_only(scene, quiet);
   const DemParams p = dem_params(c);
   ShearCell cell = build_shear_cell(c, scene.locate("particles.volume_fraction"));

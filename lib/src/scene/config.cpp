@@ -1,11 +1,17 @@
 #include "mrf/scene/config.hpp"
 
+#include <omp.h>
+
 #include <cmath>
 #include <sstream>
 
 #include "mrf/vec.hpp"
 
 namespace mrf {
+
+void use_scene_threads(const SceneConfig& c) {
+  if (c.threads > 0) omp_set_num_threads(c.threads);
+}
 
 const char* to_string(ModelId m) {
   switch (m) {

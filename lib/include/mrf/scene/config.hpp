@@ -66,6 +66,9 @@ struct SceneConfig {
 };
 
 // Mason number from shear rate and back (DESIGN.md convention).
+// Sets the OpenMP thread count of the scene's numerics.threads (0 leaves
+// the OpenMP default); every command that runs a scene calls it.
+void use_scene_threads(const SceneConfig& c);
 double mason_from_shear_rate(double shear_rate, double viscosity, double magnetization);
 double shear_rate_from_mason(double mason, double viscosity, double magnetization);
 double magnetization_from_mason(double mason, double viscosity, double shear_rate);
