@@ -175,11 +175,21 @@ ShepardField shepard_interpolate(std::size_t n_dem, const std::vector<CouplingPa
   out.s.assign(n_dem, 0.0);
   out.u.assign(n_dem, Vec3::Zero());
   out.eps.assign(n_dem, 0.0);
-  for (const CouplingPair& p : pairs) {
-    const double wv = mass / rho[p.a] * p.w;
-    out.s[p.i] += wv;
-    out.u[p.i] += wv * v[p.a];
-    out.eps[p.i] += wv * eps[p.a];
+  // pairs come in runs of one DEM particle (sorted by i): each run's sums
+  // are held in registers, loaded and stored once (the same additions in
+  // the same order as adding into out per pair, bit for bit)
+  for (std::size_t q = 0; q < pairs.size();) {
+    const std::uint32_t i = pairs[q].i;
+    double si = out.s[i], ei = out.eps[i];
+    Vec3 ui = out.u[i];
+    for (; q < pairs.size() && pairs[q].i == i; ++q) {
+      const CouplingPair& p = pairs[q];
+      const double wv = mass / rho[p.a] * p.w;
+      si += wv;
+      ui += wv * v[p.a];
+      ei += wv * eps[p.a];
+    }
+    out.s[i] = si, out.u[i] = ui, out.eps[i] = ei;
   }
   for (std::size_t i = 0; i < n_dem; ++i) {
     if (!(out.s[i] > 0.0))
@@ -194,8 +204,15 @@ ShepardField shepard_interpolate(std::size_t n_dem, const std::vector<CouplingPa
 std::vector<Vec3> shepard_rate(const std::vector<CouplingPair>& pairs, double mass, const std::vector<double>& rho,
                                const std::vector<Vec3>& v, const ShepardField& at, const std::vector<Vec3>& c) {
   std::vector<Vec3> out(at.u.size(), Vec3::Zero());
-  for (const CouplingPair& p : pairs)
-    out[p.i] += (mass / rho[p.a] * p.dw.dot(c[p.i] - v[p.a])) * (v[p.a] - at.u[p.i]);
+  for (std::size_t q = 0; q < pairs.size();) {  // by runs of i, as shepard_interpolate
+    const std::uint32_t i = pairs[q].i;
+    Vec3 oi = out[i];
+    for (; q < pairs.size() && pairs[q].i == i; ++q) {
+      const CouplingPair& p = pairs[q];
+      oi += (mass / rho[p.a] * p.dw.dot(c[i] - v[p.a])) * (v[p.a] - at.u[i]);
+    }
+    out[i] = oi;
+  }
   for (std::size_t i = 0; i < out.size(); ++i) out[i] /= at.s[i];
   return out;
 }
@@ -204,7 +221,12 @@ std::vector<Vec3> generalised_buoyancy(std::size_t n_dem, const std::vector<Coup
                                        const std::vector<double>& s, const std::vector<Vec3>& a_fluid,
                                        double particle_volume) {
   std::vector<Vec3> f(n_dem, Vec3::Zero());
-  for (const CouplingPair& p : pairs) f[p.i] += (mass * p.w) * a_fluid[p.a];  // (m/rho) W x rho a
+  for (std::size_t q = 0; q < pairs.size();) {  // by runs of i, as shepard_interpolate
+    const std::uint32_t i = pairs[q].i;
+    Vec3 fi = f[i];
+    for (; q < pairs.size() && pairs[q].i == i; ++q) fi += (mass * pairs[q].w) * a_fluid[pairs[q].a];  // (m/rho) W x rho a
+    f[i] = fi;
+  }
   for (std::size_t i = 0; i < n_dem; ++i) f[i] *= particle_volume / s[i];
   return f;
 }
