@@ -154,6 +154,23 @@ std::vector<CouplingPair> coupling_pairs(const std::vector<Vec3>& dem_x, const s
   return out;
 }
 
+namespace {
+// The runs of pairs of one DEM particle (pairs come sorted by i):
+// run(i, first, last) for each. A sum over a run is held in registers and
+// added into its array once, which gives the same additions in the same
+// order as adding per pair, bit for bit, and spares a load and a store per
+// pair that would wait for the last one.
+template <class Run>
+void by_dem_runs(const std::vector<CouplingPair>& pairs, Run run) {
+  for (std::size_t q = 0; q < pairs.size();) {
+    const std::size_t first = q;
+    const std::uint32_t i = pairs[q].i;
+    while (q < pairs.size() && pairs[q].i == i) ++q;
+    run(i, first, q);
+  }
+}
+}  // namespace
+
 PorosityField porosity_at_fluid(std::size_t n_sph, double particle_volume, const std::vector<CouplingPair>& pairs,
                                 double floor) {
   std::vector<double> solid(n_sph, 0.0);
@@ -175,14 +192,10 @@ ShepardField shepard_interpolate(std::size_t n_dem, const std::vector<CouplingPa
   out.s.assign(n_dem, 0.0);
   out.u.assign(n_dem, Vec3::Zero());
   out.eps.assign(n_dem, 0.0);
-  // pairs come in runs of one DEM particle (sorted by i): each run's sums
-  // are held in registers, loaded and stored once (the same additions in
-  // the same order as adding into out per pair, bit for bit)
-  for (std::size_t q = 0; q < pairs.size();) {
-    const std::uint32_t i = pairs[q].i;
+  by_dem_runs(pairs, [&](std::uint32_t i, std::size_t first, std::size_t last) {
     double si = out.s[i], ei = out.eps[i];
     Vec3 ui = out.u[i];
-    for (; q < pairs.size() && pairs[q].i == i; ++q) {
+    for (std::size_t q = first; q < last; ++q) {
       const CouplingPair& p = pairs[q];
       const double wv = mass / rho[p.a] * p.w;
       si += wv;
@@ -190,7 +203,7 @@ ShepardField shepard_interpolate(std::size_t n_dem, const std::vector<CouplingPa
       ei += wv * eps[p.a];
     }
     out.s[i] = si, out.u[i] = ui, out.eps[i] = ei;
-  }
+  });
   for (std::size_t i = 0; i < n_dem; ++i) {
     if (!(out.s[i] > 0.0))
       throw NumericalError("shepard_interpolate: DEM particle " + std::to_string(i) +
@@ -204,15 +217,14 @@ ShepardField shepard_interpolate(std::size_t n_dem, const std::vector<CouplingPa
 std::vector<Vec3> shepard_rate(const std::vector<CouplingPair>& pairs, double mass, const std::vector<double>& rho,
                                const std::vector<Vec3>& v, const ShepardField& at, const std::vector<Vec3>& c) {
   std::vector<Vec3> out(at.u.size(), Vec3::Zero());
-  for (std::size_t q = 0; q < pairs.size();) {  // by runs of i, as shepard_interpolate
-    const std::uint32_t i = pairs[q].i;
+  by_dem_runs(pairs, [&](std::uint32_t i, std::size_t first, std::size_t last) {
     Vec3 oi = out[i];
-    for (; q < pairs.size() && pairs[q].i == i; ++q) {
+    for (std::size_t q = first; q < last; ++q) {
       const CouplingPair& p = pairs[q];
       oi += (mass / rho[p.a] * p.dw.dot(c[i] - v[p.a])) * (v[p.a] - at.u[i]);
     }
     out[i] = oi;
-  }
+  });
   for (std::size_t i = 0; i < out.size(); ++i) out[i] /= at.s[i];
   return out;
 }
@@ -221,12 +233,11 @@ std::vector<Vec3> generalised_buoyancy(std::size_t n_dem, const std::vector<Coup
                                        const std::vector<double>& s, const std::vector<Vec3>& a_fluid,
                                        double particle_volume) {
   std::vector<Vec3> f(n_dem, Vec3::Zero());
-  for (std::size_t q = 0; q < pairs.size();) {  // by runs of i, as shepard_interpolate
-    const std::uint32_t i = pairs[q].i;
+  by_dem_runs(pairs, [&](std::uint32_t i, std::size_t first, std::size_t last) {
     Vec3 fi = f[i];
-    for (; q < pairs.size() && pairs[q].i == i; ++q) fi += (mass * pairs[q].w) * a_fluid[pairs[q].a];  // (m/rho) W x rho a
+    for (std::size_t q = first; q < last; ++q) fi += (mass * pairs[q].w) * a_fluid[pairs[q].a];  // (m/rho) W x rho a
     f[i] = fi;
-  }
+  });
   for (std::size_t i = 0; i < n_dem; ++i) f[i] *= particle_volume / s[i];
   return f;
 }
