@@ -10,6 +10,7 @@
 #include "mrf/neighbors/cell_list.hpp"
 #include "mrf/neighbors/verlet_list.hpp"
 #include "parallel_blocks.hpp"
+#include "runs.hpp"
 
 namespace mrf {
 
@@ -155,19 +156,11 @@ std::vector<CouplingPair> coupling_pairs(const std::vector<Vec3>& dem_x, const s
 }
 
 namespace {
-// The runs of pairs of one DEM particle (pairs come sorted by i):
-// run(i, first, last) for each. A sum over a run is held in registers and
-// added into its array once, which gives the same additions in the same
-// order as adding per pair, bit for bit, and spares a load and a store per
-// pair that would wait for the last one.
+// the runs of pairs of one DEM particle (pairs come sorted by i): a sum
+// over a run is held in registers and added into its array once
 template <class Run>
 void by_dem_runs(const std::vector<CouplingPair>& pairs, Run run) {
-  for (std::size_t q = 0; q < pairs.size();) {
-    const std::size_t first = q;
-    const std::uint32_t i = pairs[q].i;
-    while (q < pairs.size() && pairs[q].i == i) ++q;
-    run(i, first, q);
-  }
+  detail::for_each_run(pairs, [](const CouplingPair& p) { return p.i; }, run);
 }
 }  // namespace
 

@@ -8,37 +8,17 @@
 #include "mrf/fluid/viscosity.hpp"
 #include "mrf/integrate/pcg.hpp"
 
+#include "runs.hpp"
+
 namespace mrf {
 
 namespace {
-// A pass over the rows (a ascending in runs, b != a) that adds into out[a]
-// and out[b]: out[a] is held in registers over a run of rows with the same
-// a instead of loaded and stored per row (each store the next row's load
-// waits for). No row of a's run touches out[a] through b, so every sum
-// takes its terms in the same order as the plain loop, bit for bit.
-// `edge(a, load)` loads or stores any further per-a accumulator the same way.
-template <class Rows, class Body, class Edge>
-void by_rows(const Rows& rows, std::vector<Vec3>& out, Body body, Edge edge) {
-  if (rows.empty()) return;
-  std::uint32_t cur = rows.front().a;
-  Vec3 out_a = out[cur];
-  edge(cur, true);
-  for (const auto& e : rows) {
-    if (e.a != cur) {
-      out[cur] = out_a;
-      edge(cur, false);
-      cur = e.a;
-      out_a = out[cur];
-      edge(cur, true);
-    }
-    body(e, out_a);
-  }
-  out[cur] = out_a;
-  edge(cur, false);
-}
-template <class Rows, class Body>
-void by_rows(const Rows& rows, std::vector<Vec3>& out, Body body) {
-  by_rows(rows, out, body, [](std::uint32_t, bool) {});
+// the runs of rows of one a (rows come by a); no row of a's run reaches
+// out[a] through b (b != a), so holding out[a] over the run is bit for bit
+// the plain scatter
+template <class Rows, class Run>
+void by_rows(const Rows& rows, Run run) {
+  detail::for_each_run(rows, [](const auto& e) { return e.a; }, run);
 }
 }  // namespace
 
@@ -133,10 +113,15 @@ void ImplicitFluidSystem::scatter_pressure(std::vector<Vec3>& out) const {
     s_[a] *= q_[a];
     out[a] += s_[a] * tw_[a];
   }
-  by_rows(rows_, out, [&](const Row& e, Vec3& out_a) {
-    const Vec3 f = (s_[e.a] + s_[e.b]) * e.g;
-    out_a += f;
-    out[e.b] -= f;
+  by_rows(rows_, [&](std::uint32_t a, std::size_t first, std::size_t last) {
+    Vec3 out_a = out[a];
+    for (std::size_t r = first; r < last; ++r) {
+      const Row& e = rows_[r];
+      const Vec3 f = (s_[a] + s_[e.b]) * e.g;
+      out_a += f;
+      out[e.b] -= f;
+    }
+    out[a] = out_a;
   });
 }
 
@@ -145,9 +130,14 @@ void ImplicitFluidSystem::apply(const std::vector<Vec3>& x, std::vector<Vec3>& o
   out.resize(n);
   for (std::size_t a = 0; a < n; ++a) out[a] = vdiag_[a] * x[a];
   if (!pressure_) {
-    by_rows(rows_, out, [&](const Row& e, Vec3& out_a) {
-      out_a -= e.k * x[e.b];
-      out[e.b] -= e.k * x[e.a];
+    by_rows(rows_, [&](std::uint32_t a, std::size_t first, std::size_t last) {
+      Vec3 out_a = out[a];
+      for (std::size_t r = first; r < last; ++r) {
+        const Row& e = rows_[r];
+        out_a -= e.k * x[e.b];
+        out[e.b] -= e.k * x[a];
+      }
+      out[a] = out_a;
     });
     return;
   }
@@ -155,22 +145,20 @@ void ImplicitFluidSystem::apply(const std::vector<Vec3>& x, std::vector<Vec3>& o
   // (each sum in the same order as two passes), then the pressure's
   s_.resize(n);
   for (std::size_t a = 0; a < n; ++a) s_[a] = tw_[a].dot(x[a]);
-  double s_a = 0;
-  by_rows(
-      rows_, out,
-      [&](const Row& e, Vec3& out_a) {
-        out_a -= e.k * x[e.b];
-        out[e.b] -= e.k * x[e.a];
-        const double d = e.g.dot(x[e.a] - x[e.b]);
-        s_a += d;
-        s_[e.b] += d;
-      },
-      [&](std::uint32_t a, bool load) {
-        if (load)
-          s_a = s_[a];
-        else
-          s_[a] = s_a;
-      });
+  by_rows(rows_, [&](std::uint32_t a, std::size_t first, std::size_t last) {
+    Vec3 out_a = out[a];
+    double s_a = s_[a];
+    for (std::size_t r = first; r < last; ++r) {
+      const Row& e = rows_[r];
+      out_a -= e.k * x[e.b];
+      out[e.b] -= e.k * x[a];
+      const double d = e.g.dot(x[a] - x[e.b]);
+      s_a += d;
+      s_[e.b] += d;
+    }
+    out[a] = out_a;
+    s_[a] = s_a;
+  });
   scatter_pressure(out);
 }
 
