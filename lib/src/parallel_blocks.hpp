@@ -12,6 +12,25 @@ namespace mrf::detail {
 // [block_bound(n, blk, blocks), block_bound(n, blk + 1, blocks))).
 inline std::size_t block_bound(std::size_t n, std::size_t blk, std::size_t blocks) { return n * blk / blocks; }
 
+// The number of blocks for a pass over n items: one per thread when
+// n >= per_thread, else one.
+inline int block_count(std::size_t n, std::size_t per_thread) {
+  return n >= per_thread ? std::max(1, omp_get_max_threads()) : 1;
+}
+
+// body(blk, lo, hi) for each of `blocks` contiguous blocks of [0, n), on
+// threads when blocks > 1. A body that writes only its own items (and its
+// block's slot of a per-block result) gives the same result whatever the
+// number of threads.
+template <class Body>
+void for_blocks(std::size_t n, int blocks, Body&& body) {
+#pragma omp parallel for schedule(static, 1) if (blocks > 1)
+  for (int blk = 0; blk < blocks; ++blk) {
+    const auto b = static_cast<std::size_t>(blk), nb = static_cast<std::size_t>(blocks);
+    body(b, block_bound(n, b, nb), block_bound(n, b + 1, nb));
+  }
+}
+
 // body(lo, hi, mine) over [0, n) in contiguous blocks, one per thread when
 // n >= per_thread, each filling its own list; the lists are joined into
 // `out` in block order, so the result is the same whatever the number of
@@ -19,15 +38,13 @@ inline std::size_t block_bound(std::size_t n, std::size_t blk, std::size_t block
 // (the blocks' ranges: block_bound).
 template <class T, class Body>
 std::vector<std::size_t> in_blocks(std::size_t n, std::size_t per_thread, std::vector<T>& out, Body&& body) {
-  const int blocks = n >= per_thread ? std::max(1, omp_get_max_threads()) : 1;
+  const int blocks = block_count(n, per_thread);
   std::vector<std::vector<T>> part(static_cast<std::size_t>(blocks));
-#pragma omp parallel for schedule(static, 1) if (blocks > 1)
-  for (int blk = 0; blk < blocks; ++blk) {
-    std::vector<T>& mine = blk == 0 ? out : part[static_cast<std::size_t>(blk)];
+  for_blocks(n, blocks, [&](std::size_t b, std::size_t lo, std::size_t hi) {
+    std::vector<T>& mine = b == 0 ? out : part[b];
     mine.clear();
-    const auto b = static_cast<std::size_t>(blk), nb = static_cast<std::size_t>(blocks);
-    body(block_bound(n, b, nb), block_bound(n, b + 1, nb), mine);
-  }
+    body(lo, hi, mine);
+  });
   std::vector<std::size_t> begin(static_cast<std::size_t>(blocks), 0);
   for (int blk = 1; blk < blocks; ++blk) {
     begin[static_cast<std::size_t>(blk)] = out.size();

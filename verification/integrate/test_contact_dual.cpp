@@ -7,6 +7,7 @@
 // broken), over fixed steps 3x and 9x the explicit contact limit. Also the
 // two-stage candidate search equals the search over the whole Verlet list.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -213,6 +214,74 @@ TEST(ContactDual, CoupledWallContactsOfOneSphereFactorExactly) {
   EXPECT_GT(left, 0.0);
   EXPECT_GT(right, 0.0);
   EXPECT_NEAR(f[0].x(), k * std::pow(left, 1.5) - k * std::pow(right, 1.5), 1e-9 * k * std::pow(left, 1.5));
+}
+
+// The solve's passes run on threads by blocks of pairs and of spheres, each
+// sphere's terms summed in the order of the serial pass over the contacts:
+// on the paper cell (thousands of active contacts, enough for the threaded
+// passes), 2 threads give the 1-thread solve bit for bit, for model 1's
+// mobility (Jacobi, a pass over the contacts on one thread) and a coupled
+// one (IC(0), whose assembly reads the sphere index on one thread too).
+TEST(ContactDual, TwoThreadsGiveTheSerialSolveBitForBit) {
+  const LoadedScene sc =
+      load_scene(MRF_SOURCE_DIR "/experiments/scenes/paper_dem_stokes.toml", {"numerics.threads=1"});
+  const DemParams p = dem_params(sc.config);
+  DemModel m(build_shear_cell(sc.config), p, IntegratorId::implicit,
+             smallest(dem_limits(p, sc.config.gap, IntegratorId::implicit)));
+  for (int n = 0; n < 30; ++n) m.step();
+  const ShearCell& c = m.cell();
+  std::vector<ContactPair> pairs;
+  contact_candidates(m.lists(), c.free.x, c.walls, c.box, p.radius, 0.2 * p.radius, pairs);
+  // every sphere pushed by 0.05 R in a direction of its own
+  std::vector<Vec3> b = c.free.x;
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    const double t = static_cast<double>(i);
+    b[i] += 0.05 * p.radius * Vec3(std::cos(t), std::sin(1.7 * t), std::cos(2.3 * t)).normalized();
+  }
+  const std::vector<double> mob(b.size(), 1e-6 / p.gamma);
+  NewtonOptions opt;
+  opt.tol = 1e-6 * p.radius;
+  opt.max_iterations = 30;
+  opt.linear_rtol = 1e-2;
+  UniformCoupling fluid(0.01 / p.gamma);  // s C = 0.01 of the drag mobility
+  for (const bool coupled : {false, true}) {
+    std::vector<Vec3> y[2];
+    NewtonResult res[2];
+    std::vector<Vec3> f[2];
+    for (int t = 0; t < 2; ++t) {
+      const int saved = omp_get_max_threads();
+      omp_set_num_threads(t + 1);
+      ContactDual dual;
+      res[t] = dual.solve(pairs, b, c.free.x, c.walls, c.walls, c.box, p.radius, p.hertz_k, mob,
+                          coupled ? &fluid : nullptr, 1e-6, opt, y[t]);
+      omp_set_num_threads(saved);
+      f[t].assign(b.size(), Vec3::Zero());
+      dual.add_forces(pairs, f[t]);
+    }
+    std::size_t touching = 0;
+    std::vector<char> in_contact(b.size(), 0);
+    for (const ContactPair& pc : pairs) {
+      if (c.box.min_image(y[0][pc.i] - (pc.wall ? c.walls.x[pc.k] : y[0][pc.k])).norm() >= 2 * p.radius) continue;
+      ++touching;
+      in_contact[pc.i] = 1;
+      if (!pc.wall) in_contact[pc.k] = 1;
+    }
+    const auto spheres = static_cast<std::size_t>(std::count(in_contact.begin(), in_contact.end(), 1));
+    std::printf("%s: %zu candidates, %zu contacts on %zu spheres; Newton %d, CG %ld, converged %d\n",
+                coupled ? "coupled, IC(0)" : "model 1, Jacobi", pairs.size(), touching, spheres, res[0].iterations,
+                res[0].linear_iterations, res[0].converged ? 1 : 0);
+    EXPECT_GT(spheres, 2048u) << "enough spheres in contact for the threaded passes";
+    EXPECT_TRUE(res[0].converged);
+    EXPECT_GE(res[0].iterations, 3) << "a solve of several Newton iterations";
+    EXPECT_EQ(res[0].iterations, res[1].iterations);
+    EXPECT_EQ(res[0].linear_iterations, res[1].linear_iterations);
+    EXPECT_EQ(res[0].worst, res[1].worst);
+    EXPECT_EQ(res[0].last_correction, res[1].last_correction);
+    for (std::size_t i = 0; i < b.size(); ++i) {
+      ASSERT_EQ(y[0][i], y[1][i]) << "sphere " << i;
+      ASSERT_EQ(f[0][i], f[1][i]) << "sphere " << i;
+    }
+  }
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 
 #include "mrf/forces/hertz.hpp"
 #include "mrf/neighbors/cell_list.hpp"
+#include "parallel_blocks.hpp"
 
 namespace mrf {
 
@@ -15,24 +16,94 @@ Vec3 pair_vector(const ContactPair& c, const std::vector<Vec3>& x, const WallPar
   d.z() = mi.wrap_z(d.z());
   return d;
 }
+
+// Items (pairs, contacts, spheres) a thread takes at least in the solve's
+// passes; fewer run on one thread.
+constexpr std::size_t k_dual_per_thread = 1024;
+
+// The largest |v| of a pass and the sphere it belongs to, as a serial pass
+// in order that keeps the first strict maximum finds it; merged block by
+// block in order, so whatever the number of threads.
+struct Worst {
+  double v = 0;
+  std::uint32_t i = 0;
+  bool set = false;
+  void see(double x, std::uint32_t at) {
+    if (std::abs(x) > v) v = std::abs(x), i = at, set = true;
+  }
+};
 }  // namespace
 
-void ContactDual::move(const std::vector<ContactPair>& pairs, const std::vector<double>& q, bool active_only,
+// act_particles_, and where more than one thread runs the passes over the
+// spheres (or IC(0) is assembled), per sphere its entries in act_ ascending,
+// each with the contact's normal signed as G puts it on the sphere (+n at
+// i, -n at k). A pass by sphere adds each sphere's terms in the order of the
+// serial pass over the contacts (m (q (-n)) = -(m (q n)) exactly), so the
+// result is the same bit for bit whatever the number of threads; on one
+// thread the pass over the contacts runs, which is faster there.
+void ContactDual::index_spheres(const std::vector<ContactPair>& pairs) {
+  const std::size_t n = disp_.size();
+  row_start_.assign(n + 1, 0);
+  for (auto c : act_) {
+    ++row_start_[pairs[c].i + 1];
+    if (!pairs[c].wall) ++row_start_[pairs[c].k + 1];
+  }
+  act_particles_.clear();
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (row_start_[i + 1] > 0) act_particles_.push_back(i);
+    row_start_[i + 1] += row_start_[i];
+  }
+  sphere_blocks_ = detail::block_count(act_particles_.size(), k_dual_per_thread);
+  if (sphere_blocks_ == 1 && !uses_ic0()) return;
+  row_entry_.resize(row_start_[n]);
+  row_fill_.assign(row_start_.begin(), row_start_.end() - 1);
+  for (std::uint32_t a = 0; a < act_.size(); ++a) {
+    const std::uint32_t c = act_[a];
+    const ContactPair& pc = pairs[c];
+    row_entry_[row_fill_[pc.i]++] = {n_[c], a};
+    if (!pc.wall) row_entry_[row_fill_[pc.k]++] = {-n_[c], a};
+  }
+}
+
+bool ContactDual::uses_ic0() const {
+  return precond_ == Preconditioner::incomplete_cholesky || (precond_ == Preconditioner::automatic && coupled_);
+}
+
+void ContactDual::move(const std::vector<ContactPair>& pairs, const std::vector<double>& q, bool by_pair,
                        std::vector<Vec3>& y) {
   const std::vector<double>& mob = *mob_;
-  const std::size_t m = active_only ? act_.size() : pairs.size();
   if (coupled_) s_.assign(y.size(), Vec3::Zero());
-  for (std::size_t a = 0; a < m; ++a) {
-    const std::size_t c = active_only ? act_[a] : a;
-    if (q[a] == 0) continue;
-    const ContactPair& pc = pairs[c];
-    const Vec3 f = q[a] * n_[c];
-    y[pc.i] += mob[pc.i] * f;
-    if (!pc.wall) y[pc.k] -= mob[pc.k] * f;
-    if (coupled_) {
-      s_[pc.i] += f;
-      if (!pc.wall) s_[pc.k] -= f;
+  if (sphere_blocks_ == 1) {
+    for (std::size_t a = 0; a < act_.size(); ++a) {
+      const std::uint32_t c = act_[a];
+      const double v = by_pair ? q[c] : q[a];
+      if (v == 0) continue;
+      const ContactPair& pc = pairs[c];
+      const Vec3 f = v * n_[c];
+      y[pc.i] += mob[pc.i] * f;
+      if (!pc.wall) y[pc.k] -= mob[pc.k] * f;
+      if (coupled_) {
+        s_[pc.i] += f;
+        if (!pc.wall) s_[pc.k] -= f;
+      }
     }
+  } else {
+    detail::for_blocks(act_particles_.size(), sphere_blocks_, [&](std::size_t, std::size_t lo, std::size_t hi) {
+      for (std::size_t t = lo; t < hi; ++t) {
+        const std::uint32_t i = act_particles_[t];
+        Vec3 yi = y[i], si = Vec3::Zero();
+        for (std::uint32_t e = row_start_[i]; e < row_start_[i + 1]; ++e) {
+          const SphereEntry& en = row_entry_[e];
+          const double v = by_pair ? q[act_[en.a]] : q[en.a];
+          if (v == 0) continue;
+          const Vec3 f = v * en.sn;
+          yi += mob[i] * f;
+          si += f;
+        }
+        y[i] = yi;
+        if (coupled_) s_[i] = si;
+      }
+    });
   }
   if (coupled_) coupled_->add(s_, coupled_scale_, y);
 }
@@ -51,38 +122,76 @@ void ContactDual::add_forces(const std::vector<ContactPair>& pairs, std::vector<
 void ContactDual::apply(const std::vector<ContactPair>& pairs, const std::vector<double>& p,
                         std::vector<double>& out) {
   const std::vector<double>& mob = *mob_;
-  out.resize(act_.size());
+  const std::size_t m = act_.size(), ns = act_particles_.size();
+  out.resize(m);
+  const int contact_blocks = detail::block_count(m, k_dual_per_thread);
   if (!coupled_) {  // the packed copy of this linear solve (solve_cg): no indirection, no branch
-    for (auto i : act_particles_) pdisp_[i].setZero();
-    for (std::size_t a = 0; a < packed_.size(); ++a) {
-      const Packed& e = packed_[a];
-      const Vec3 g = p[a] * e.n;
-      pdisp_[e.i] += e.mob_i * g;
-      pdisp_[e.k] -= e.mob_k * g;  // a wall pair: the spare row, 0 * g
+    if (sphere_blocks_ == 1) {
+      for (auto i : act_particles_) pdisp_[i].setZero();
+      for (std::size_t a = 0; a < m; ++a) {
+        const Packed& e = packed_[a];
+        const Vec3 g = p[a] * e.n;
+        pdisp_[e.i] += e.mob_i * g;
+        pdisp_[e.k] -= e.mob_k * g;  // a wall pair: the spare row, 0 * g
+      }
+    } else {
+    detail::for_blocks(ns, sphere_blocks_, [&](std::size_t, std::size_t lo, std::size_t hi) {
+      for (std::size_t t = lo; t < hi; ++t) {
+        const std::uint32_t i = act_particles_[t];
+        const double mi = mob[i];
+        Vec3 d = Vec3::Zero();
+        for (std::uint32_t e = row_start_[i]; e < row_start_[i + 1]; ++e) {
+          const SphereEntry& en = row_entry_[e];
+          d += mi * (p[en.a] * en.sn);
+        }
+        pdisp_[i] = d;
+      }
+    });
     }
-    for (std::size_t a = 0; a < packed_.size(); ++a) {
-      const Packed& e = packed_[a];
-      out[a] = e.n.dot(pdisp_[e.i] - pdisp_[e.k]) + e.comp * p[a];
-    }
+    detail::for_blocks(m, contact_blocks, [&](std::size_t, std::size_t lo, std::size_t hi) {
+      for (std::size_t a = lo; a < hi; ++a) {
+        const Packed& e = packed_[a];
+        out[a] = e.n.dot(pdisp_[e.i] - pdisp_[e.k]) + e.comp * p[a];  // a wall pair's k: the spare row, 0
+      }
+    });
     return;
   }
-  for (auto i : act_particles_) disp_[i].setZero();
   s_.assign(disp_.size(), Vec3::Zero());
-  for (std::size_t a = 0; a < act_.size(); ++a) {
-    const ContactPair& c = pairs[act_[a]];
-    const Vec3 g = p[a] * n_[act_[a]];
-    disp_[c.i] += mob[c.i] * g;
-    if (!c.wall) disp_[c.k] -= mob[c.k] * g;
-    s_[c.i] += g;
-    if (!c.wall) s_[c.k] -= g;
+  if (sphere_blocks_ == 1) {
+    for (auto i : act_particles_) disp_[i].setZero();
+    for (std::size_t a = 0; a < m; ++a) {
+      const ContactPair& c = pairs[act_[a]];
+      const Vec3 g = p[a] * n_[act_[a]];
+      disp_[c.i] += mob[c.i] * g;
+      if (!c.wall) disp_[c.k] -= mob[c.k] * g;
+      s_[c.i] += g;
+      if (!c.wall) s_[c.k] -= g;
+    }
+  } else {
+  detail::for_blocks(ns, sphere_blocks_, [&](std::size_t, std::size_t lo, std::size_t hi) {
+    for (std::size_t t = lo; t < hi; ++t) {
+      const std::uint32_t i = act_particles_[t];
+      Vec3 d = Vec3::Zero(), si = Vec3::Zero();
+      for (std::uint32_t e = row_start_[i]; e < row_start_[i + 1]; ++e) {
+        const SphereEntry& en = row_entry_[e];
+        const Vec3 g = p[en.a] * en.sn;
+        d += mob[i] * g;
+        si += g;
+      }
+      disp_[i] = d;
+      s_[i] = si;
+    }
+  });
   }
   coupled_->add(s_, coupled_scale_, disp_, &act_particles_);
-  for (std::size_t a = 0; a < act_.size(); ++a) {
-    const std::uint32_t e = act_[a];
-    const ContactPair& c = pairs[e];
-    const Vec3 rel = c.wall ? disp_[c.i] : Vec3(disp_[c.i] - disp_[c.k]);
-    out[a] = n_[e].dot(rel) + comp_[e] * p[a];
-  }
+  detail::for_blocks(m, contact_blocks, [&](std::size_t, std::size_t lo, std::size_t hi) {
+    for (std::size_t a = lo; a < hi; ++a) {
+      const std::uint32_t e = act_[a];
+      const ContactPair& c = pairs[e];
+      const Vec3 rel = c.wall ? disp_[c.i] : Vec3(disp_[c.i] - disp_[c.k]);
+      out[a] = n_[e].dot(rel) + comp_[e] * p[a];
+    }
+  });
 }
 
 long ContactDual::solve_cg(const std::vector<ContactPair>& pairs, double rtol) {
@@ -98,17 +207,18 @@ long ContactDual::solve_cg(const std::vector<ContactPair>& pairs, double rtol) {
     pdisp_[spare].setZero();
     packed_.resize(m);
   }
-  for (std::size_t a = 0; a < m; ++a) {
-    const std::uint32_t e = act_[a];
-    const ContactPair& c = pairs[e];
-    const double mob_k = c.wall ? 0.0 : mob[c.k];
-    diag_[a] = mob[c.i] + mob_k + comp_[e] + (coupled_ ? crel_[e] : 0.0);
-    r_[a] = rhs_[e];
-    if (!coupled_) packed_[a] = {n_[e], mob[c.i], mob_k, comp_[e], c.i, c.wall ? spare : c.k};
-  }
+  detail::for_blocks(m, detail::block_count(m, k_dual_per_thread), [&](std::size_t, std::size_t lo, std::size_t hi) {
+    for (std::size_t a = lo; a < hi; ++a) {
+      const std::uint32_t e = act_[a];
+      const ContactPair& c = pairs[e];
+      const double mob_k = c.wall ? 0.0 : mob[c.k];
+      diag_[a] = mob[c.i] + mob_k + comp_[e] + (coupled_ ? crel_[e] : 0.0);
+      r_[a] = rhs_[e];
+      if (!coupled_) packed_[a] = {n_[e], mob[c.i], mob_k, comp_[e], c.i, c.wall ? spare : c.k};
+    }
+  });
   auto apply_a = [&](const std::vector<double>& p, std::vector<double>& out) { apply(pairs, p, out); };
-  const bool ic0 = precond_ == Preconditioner::incomplete_cholesky ||
-                   (precond_ == Preconditioner::automatic && coupled_ != nullptr);
+  const bool ic0 = uses_ic0();
   if (ic0 && factor_ic0(pairs))
     return pcg(
         r_, rtol, 10 * static_cast<long>(m) + 10, apply_a,
@@ -124,25 +234,7 @@ long ContactDual::solve_cg(const std::vector<ContactPair>& pairs, double rtol) {
 
 bool ContactDual::factor_ic0(const std::vector<ContactPair>& pairs) {
   const std::vector<double>& mob = *mob_;
-  const std::size_t m = act_.size(), n = disp_.size();
-  // the active contacts of each sphere
-  sph_start_.assign(n + 1, 0);
-  for (std::size_t a = 0; a < m; ++a) {
-    const ContactPair& c = pairs[act_[a]];
-    ++sph_start_[c.i + 1];
-    if (!c.wall) ++sph_start_[c.k + 1];
-  }
-  for (std::size_t i = 0; i < n; ++i) sph_start_[i + 1] += sph_start_[i];
-  sph_act_.resize(sph_start_[n]);
-  {
-    std::vector<std::uint32_t>& fill = l_start_;  // scratch
-    fill.assign(sph_start_.begin(), sph_start_.end() - 1);
-    for (std::size_t a = 0; a < m; ++a) {
-      const ContactPair& c = pairs[act_[a]];
-      sph_act_[fill[c.i]++] = static_cast<std::uint32_t>(a);
-      if (!c.wall) sph_act_[fill[c.k]++] = static_cast<std::uint32_t>(a);
-    }
-  }
+  const std::size_t m = act_.size();
   // Row a of A below the diagonal: b < a sharing a sphere p, entry
   // s_a s_b mob_p n_a . n_b (s = +1 on i, -1 on k). Two contacts share at
   // most one sphere, so no entry is found twice; rows come out ascending
@@ -158,8 +250,8 @@ bool ContactDual::factor_ic0(const std::vector<ContactPair>& pairs) {
     for (int end = 0; end < (c.wall ? 1 : 2); ++end) {
       const std::uint32_t p = end == 0 ? c.i : c.k;
       const double sa = end == 0 ? 1.0 : -1.0;
-      for (std::uint32_t e = sph_start_[p]; e < sph_start_[p + 1]; ++e) {
-        const std::uint32_t b = sph_act_[e];
+      for (std::uint32_t e = row_start_[p]; e < row_start_[p + 1]; ++e) {  // index_spheres
+        const std::uint32_t b = row_entry_[e].a;
         if (b >= a) break;
         const ContactPair& cb = pairs[act_[b]];
         const double sb = cb.i == p ? 1.0 : -1.0;
@@ -237,8 +329,7 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
   rhs_.resize(np);
   s_.resize(b.size());
   disp_.resize(b.size());
-  seen_.assign(b.size(), 0);
-  std::uint32_t stamp = 1;
+  const int pair_blocks = detail::block_count(np, k_dual_per_thread);
   if (coupled_) {  // s (C_ii + C_kk - 2 C_ik) of each candidate: the diagonal of s G^T C G (Jacobi)
     crel_.resize(np);
     cik_.resize(np);
@@ -256,79 +347,103 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
   // open pair costs no square root or division here or below: most
   // candidates are open.
   const double two_r2 = two_r * two_r;
-  for (std::size_t c = 0; c < np; ++c) {
-    const Vec3 r = pair_vector(pairs[c], x_start, walls_start, mi);
-    const double r2 = r.squaredNorm();
-    if (r2 >= two_r2) {
-      lambda_[c] = 0.0;
-      continue;
+  detail::for_blocks(np, pair_blocks, [&](std::size_t, std::size_t lo, std::size_t hi) {
+    for (std::size_t c = lo; c < hi; ++c) {
+      const Vec3 r = pair_vector(pairs[c], x_start, walls_start, mi);
+      const double r2 = r.squaredNorm();
+      if (r2 >= two_r2) {
+        lambda_[c] = 0.0;
+        continue;
+      }
+      const double rn = std::sqrt(r2);
+      n_[c] = r * (1.0 / rn);
+      lambda_[c] = hertz_force(two_r - rn, hertz_k);
     }
-    const double rn = std::sqrt(r2);
-    n_[c] = r * (1.0 / rn);
-    lambda_[c] = hertz_force(two_r - rn, hertz_k);
-  }
+  });
+  // Every pair with a force is active in the passes below (an active set
+  // holds every pair with lambda > 0), so a move by the active set's forces
+  // is a move by all of them.
+  act_.clear();
+  for (std::size_t c = 0; c < np; ++c)
+    if (lambda_[c] > 0) act_.push_back(static_cast<std::uint32_t>(c));
+  index_spheres(pairs);
   y = b;
-  move(pairs, lambda_, false, y);
+  move(pairs, lambda_, true, y);
   const double inv_k23 = 1.0 / std::cbrt(hertz_k * hertz_k);  // k^{-2/3}
   // lambda += t d on the active set (projected on lambda >= 0), y moved by
   // the change along the current normals
   auto update = [&](double t, const std::vector<double>& d, std::vector<Vec3>& y_out) {
-    dq_.resize(act_.size());
-    for (std::size_t a = 0; a < act_.size(); ++a) {
-      const std::uint32_t c = act_[a];
-      const double updated = std::max(0.0, lambda_[c] + t * d[a]);
-      dq_[a] = updated - lambda_[c];
-      lambda_[c] = updated;
-    }
-    move(pairs, dq_, true, y_out);
+    const std::size_t m = act_.size();
+    dq_.resize(m);
+    detail::for_blocks(m, detail::block_count(m, k_dual_per_thread), [&](std::size_t, std::size_t lo, std::size_t hi) {
+      for (std::size_t a = lo; a < hi; ++a) {
+        const std::uint32_t c = act_[a];
+        const double updated = std::max(0.0, lambda_[c] + t * d[a]);
+        dq_[a] = updated - lambda_[c];
+        lambda_[c] = updated;
+      }
+    });
+    move(pairs, dq_, false, y_out);
   };
+  act_part_.resize(static_cast<std::size_t>(pair_blocks));
+  std::vector<Worst> worst_of(static_cast<std::size_t>(std::max(pair_blocks, 1)));
   NewtonResult res;
   double prev_worst = 0, theta = 1.0;
   for (res.iterations = 1; res.iterations <= opt.max_iterations; ++res.iterations) {
-    // Residuals at y, normals updated to y; y_next = b + M G(y) lambda.
-    act_.clear();
+    // Residuals at y, normals updated to y; y_next = b + M G(y) lambda. By
+    // blocks of pairs, each listing its active pairs, joined in order.
+    worst_of.assign(static_cast<std::size_t>(pair_blocks), Worst{});
+    detail::for_blocks(np, pair_blocks, [&](std::size_t blk, std::size_t lo, std::size_t hi) {
+      std::vector<std::uint32_t>& mine = blk == 0 ? act_ : act_part_[blk];
+      mine.clear();
+      Worst& w = worst_of[blk];
+      for (std::size_t c = lo; c < hi; ++c) {
+        const ContactPair& pc = pairs[c];
+        const Vec3 r = pair_vector(pc, y, walls, mi);
+        const double r2 = r.squaredNorm();
+        if (lambda_[c] <= 0 && r2 >= two_r2) continue;  // open and staying open
+        const double rn = std::sqrt(r2), h = two_r - rn;
+        n_[c] = r * (1.0 / rn);
+        const double h_lambda = std::cbrt(lambda_[c] * lambda_[c]) * inv_k23;  // (lambda/k)^{2/3}
+        const double phi = h - h_lambda;  // the Hertz law's residual as an overlap
+        rhs_[c] = phi;
+        // Compliance slope: of the current force, or for a contact closing
+        // from zero force, of the Hertz law at the overlap y gives it.
+        comp_[c] = lambda_[c] > 0 ? 2.0 * h_lambda / (3.0 * lambda_[c]) : 1.0 / hertz_local_stiffness(h, hertz_k);
+        mine.push_back(static_cast<std::uint32_t>(c));
+        w.see(phi, pc.i);
+      }
+    });
+    for (int blk = 1; blk < pair_blocks; ++blk)
+      act_.insert(act_.end(), act_part_[static_cast<std::size_t>(blk)].begin(),
+                  act_part_[static_cast<std::size_t>(blk)].end());
     double worst = 0;
-    for (std::size_t c = 0; c < np; ++c) {
-      const ContactPair& pc = pairs[c];
-      const Vec3 r = pair_vector(pc, y, walls, mi);
-      const double r2 = r.squaredNorm();
-      if (lambda_[c] <= 0 && r2 >= two_r2) continue;  // open and staying open
-      const double rn = std::sqrt(r2), h = two_r - rn;
-      n_[c] = r * (1.0 / rn);
-      const double h_lambda = std::cbrt(lambda_[c] * lambda_[c]) * inv_k23;  // (lambda/k)^{2/3}
-      const double phi = h - h_lambda;  // the Hertz law's residual as an overlap
-      rhs_[c] = phi;
-      // Compliance slope: of the current force, or for a contact closing
-      // from zero force, of the Hertz law at the overlap y gives it.
-      comp_[c] = lambda_[c] > 0 ? 2.0 * h_lambda / (3.0 * lambda_[c]) : 1.0 / hertz_local_stiffness(h, hertz_k);
-      act_.push_back(static_cast<std::uint32_t>(c));
-      if (std::abs(phi) > worst) worst = std::abs(phi), res.worst = pc.i;
-    }
-    // The spheres of active contacts, ascending (the coupled products read
-    // their rows in this order): marked, then collected by one pass, which
-    // costs less than sorting the contacts' ends (11 % of a model-1 run).
-    for (auto c : act_) {
-      seen_[pairs[c].i] = stamp;
-      if (!pairs[c].wall) seen_[pairs[c].k] = stamp;
-    }
-    act_particles_.clear();
-    for (std::uint32_t i = 0; i < seen_.size(); ++i)
-      if (seen_[i] == stamp) act_particles_.push_back(i);
-    ++stamp;
+    auto merge = [&](const Worst& w) {
+      if (w.set && w.v > worst) worst = w.v, res.worst = w.i;
+    };
+    for (const Worst& w : worst_of) merge(w);
+    index_spheres(pairs);
     y_next_ = b;
-    move(pairs, lambda_, false, y_next_);
+    move(pairs, lambda_, true, y_next_);
     // y was placed with the normals of the last iterate; with the normals
     // just updated, y - y_next = r_y. Newton on (y, lambda) with r_y
     // eliminated: (A + C) dlambda = phi + G^T r_y, and the next y is
     // y_next + M G(y) dlambda. Without the G^T r_y term the normals
     // converge only linearly (30 % more iterations).
-    for (auto c : act_) {
-      const ContactPair& pc = pairs[c];
-      const Vec3 ry = pc.wall ? Vec3(y[pc.i] - y_next_[pc.i])
-                              : Vec3((y[pc.i] - y_next_[pc.i]) - (y[pc.k] - y_next_[pc.k]));
-      rhs_[c] += n_[c].dot(ry);
-      if (std::abs(rhs_[c]) > worst) worst = std::abs(rhs_[c]), res.worst = pc.i;
-    }
+    const std::size_t m = act_.size();
+    const int act_blocks = detail::block_count(m, k_dual_per_thread);
+    worst_of.assign(static_cast<std::size_t>(act_blocks), Worst{});
+    detail::for_blocks(m, act_blocks, [&](std::size_t blk, std::size_t lo, std::size_t hi) {
+      for (std::size_t a = lo; a < hi; ++a) {
+        const std::uint32_t c = act_[a];
+        const ContactPair& pc = pairs[c];
+        const Vec3 ry = pc.wall ? Vec3(y[pc.i] - y_next_[pc.i])
+                                : Vec3((y[pc.i] - y_next_[pc.i]) - (y[pc.k] - y_next_[pc.k]));
+        rhs_[c] += n_[c].dot(ry);
+        worst_of[blk].see(rhs_[c], pc.i);
+      }
+    });
+    for (const Worst& w : worst_of) merge(w);
     // Backtracking: an update that more than doubled the largest residual
     // is undone and taken at half its length (down to 1/8; each try counts
     // as an iteration). Without it the coupled solve can cycle: a contact
@@ -342,6 +457,7 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
       y = y_prev_;
       n_.swap(n_prev_);
       act_.swap(act_prev_);
+      index_spheres(pairs);  // of the previous active set (the next iteration indexes its own)
       update(theta, d_prev_, y);
       act_.swap(act_prev_);
       n_.swap(n_prev_);

@@ -58,9 +58,13 @@ class ContactDual {
   void set_preconditioner(Preconditioner p) { precond_ = p; }
 
  private:
-  // y += M G q for the pair values q (all pairs, or the active set)
-  void move(const std::vector<ContactPair>& pairs, const std::vector<double>& q, bool active_only,
+  // y += M G q over the active set, q per active contact (by_pair: per
+  // candidate pair, read at act_), by the sphere index of index_spheres
+  void move(const std::vector<ContactPair>& pairs, const std::vector<double>& q, bool by_pair,
             std::vector<Vec3>& y);
+  // act_particles_ and, per sphere, its entries in act_ (row_start_, row_entry_)
+  void index_spheres(const std::vector<ContactPair>& pairs);
+  bool uses_ic0() const;  // the preconditioner of this solve
   // (A + C) p on the active set
   void apply(const std::vector<ContactPair>& pairs, const std::vector<double>& p, std::vector<double>& out);
   long solve_cg(const std::vector<ContactPair>& pairs, double rtol);
@@ -84,9 +88,20 @@ class ContactDual {
   // Coupled solves: s (C_ii + C_kk - 2 C_ik) and C_ik (0 for a wall pair).
   std::vector<double> lambda_, comp_, rhs_, crel_, cik_;
   std::vector<Vec3> n_;
-  std::vector<std::uint32_t> act_;           // active pairs
+  std::vector<std::uint32_t> act_;           // active pairs, ascending
+  std::vector<std::vector<std::uint32_t>> act_part_;  // the active pairs of each block of pairs but the first
   std::vector<std::uint32_t> act_particles_;  // the spheres of active pairs, ascending
-  std::vector<std::uint32_t> seen_;           // per sphere: the iteration that listed it in act_particles_
+  // Per sphere (CSR over all spheres), its entries in act_, ascending: the
+  // contact's normal as G puts it on the sphere (+n at i, -n at k) and its
+  // place a in act_. Every pass over the spheres (and IC(0)'s assembly)
+  // reads it.
+  struct SphereEntry {
+    Vec3 sn;
+    std::uint32_t a;
+  };
+  std::vector<SphereEntry> row_entry_;
+  std::vector<std::uint32_t> row_start_, row_fill_;
+  int sphere_blocks_ = 1;  // blocks of the passes over the spheres: 1, a pass over the contacts instead
   std::vector<double> d_, r_, diag_, dq_;           // CG on the active set: solution, right-hand side, Jacobi diagonal
   PcgScratch<double> cg_;
   // The last Newton update, for a backtrack: forces, positions and normals
@@ -95,8 +110,8 @@ class ContactDual {
   std::vector<Vec3> y_prev_, n_prev_;
   std::vector<std::uint32_t> act_prev_;
   // IC(0): the strictly lower part of L by rows (columns ascending) and its
-  // diagonal; per sphere its active contacts (CSR over the spheres).
-  std::vector<std::uint32_t> l_start_, l_col_, sph_start_, sph_act_;
+  // diagonal.
+  std::vector<std::uint32_t> l_start_, l_col_;
   std::vector<double> l_val_, l_diag_;
   mutable std::vector<double> ic_y_;
   std::vector<std::pair<std::uint32_t, double>> ic_row_;  // scratch: one row of A while it is assembled
