@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <vector>
 
@@ -11,6 +12,15 @@ namespace mrf::detail {
 // Where block `blk` of `blocks` starts in [0, n) (block blk covers
 // [block_bound(n, blk, blocks), block_bound(n, blk + 1, blocks))).
 inline std::size_t block_bound(std::size_t n, std::size_t blk, std::size_t blocks) { return n * blk / blocks; }
+
+// The same for rows whose work falls linearly to 0 along [0, n), as row i
+// of a half pair list (partners j > i) in an order unrelated to space: the
+// blocks hold equal shares of n - i, ending at n (1 - sqrt(1 - blk/blocks)).
+inline std::size_t triangle_bound(std::size_t n, std::size_t blk, std::size_t blocks) {
+  if (blk >= blocks) return n;
+  const double x = 1.0 - std::sqrt(1.0 - static_cast<double>(blk) / static_cast<double>(blocks));
+  return std::min(n, static_cast<std::size_t>(x * static_cast<double>(n)));
+}
 
 // The number of blocks for a pass over n items: one per thread when
 // n >= per_thread, else one.
@@ -22,12 +32,13 @@ inline int block_count(std::size_t n, std::size_t per_thread) {
 // threads when blocks > 1. A body that writes only its own items (and its
 // block's slot of a per-block result) gives the same result whatever the
 // number of threads.
-template <class Body>
-void for_blocks(std::size_t n, int blocks, Body&& body) {
+// bound(n, blk, blocks): where block blk starts (block_bound: equal blocks).
+template <class Body, class Bound = decltype(&block_bound)>
+void for_blocks(std::size_t n, int blocks, Body&& body, Bound bound = &block_bound) {
 #pragma omp parallel for schedule(static, 1) if (blocks > 1)
   for (int blk = 0; blk < blocks; ++blk) {
     const auto b = static_cast<std::size_t>(blk), nb = static_cast<std::size_t>(blocks);
-    body(b, block_bound(n, b, nb), block_bound(n, b + 1, nb));
+    body(b, bound(n, b, nb), bound(n, b + 1, nb));
   }
 }
 
@@ -35,16 +46,20 @@ void for_blocks(std::size_t n, int blocks, Body&& body) {
 // n >= per_thread, each filling its own list; the lists are joined into
 // `out` in block order, so the result is the same whatever the number of
 // threads. Returns where each block's entries begin in `out`, one per block
-// (the blocks' ranges: block_bound).
-template <class T, class Body>
-std::vector<std::size_t> in_blocks(std::size_t n, std::size_t per_thread, std::vector<T>& out, Body&& body) {
+// (the blocks' ranges: `bound`, block_bound unless given).
+template <class T, class Body, class Bound = decltype(&block_bound)>
+std::vector<std::size_t> in_blocks(std::size_t n, std::size_t per_thread, std::vector<T>& out, Body&& body,
+                                   Bound bound = &block_bound) {
   const int blocks = block_count(n, per_thread);
   std::vector<std::vector<T>> part(static_cast<std::size_t>(blocks));
-  for_blocks(n, blocks, [&](std::size_t b, std::size_t lo, std::size_t hi) {
-    std::vector<T>& mine = b == 0 ? out : part[b];
-    mine.clear();
-    body(lo, hi, mine);
-  });
+  for_blocks(
+      n, blocks,
+      [&](std::size_t b, std::size_t lo, std::size_t hi) {
+        std::vector<T>& mine = b == 0 ? out : part[b];
+        mine.clear();
+        body(lo, hi, mine);
+      },
+      bound);
   std::vector<std::size_t> begin(static_cast<std::size_t>(blocks), 0);
   for (int blk = 1; blk < blocks; ++blk) {
     begin[static_cast<std::size_t>(blk)] = out.size();
