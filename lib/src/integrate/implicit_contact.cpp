@@ -8,8 +8,15 @@
 
 #include "mrf/forces/hertz.hpp"
 #include "mrf/integrate/pcg.hpp"
+#include "parallel_blocks.hpp"
 
 namespace mrf {
+
+namespace {
+// rows of the dipole list, and near pairs, a thread takes at least
+constexpr std::size_t k_candidate_rows_per_thread = 1000;
+constexpr std::size_t k_candidate_pairs_per_thread = 4096;
+}  // namespace
 
 const char* to_string(ContactLinearSolver s) {
   switch (s) {
@@ -35,27 +42,39 @@ void contact_candidates(const DemPairLists& lists, const std::vector<Vec3>& x, c
     if (box.min_image(x[i] - walls.x[k]).squaredNorm() < reach2) out.push_back({i, k, true});
 }
 
+// Both on threads by blocks (detail::in_blocks: lists joined in block order,
+// the serial lists whatever the threads).
 void near_pairs(const PairRows& ff, const std::vector<Vec3>& x, const Box& box, double reach,
                 std::vector<ContactPair>& out) {
-  out.clear();
   const double reach2 = reach * reach;
-  for (std::size_t i = 0; i < ff.rows(); ++i)
-    for (std::uint32_t n = ff.start[i]; n < ff.start[i + 1]; ++n) {
-      const std::uint32_t k = ff.k[n];
-      if (box.min_image(x[i] - x[k]).squaredNorm() < reach2) out.push_back({static_cast<std::uint32_t>(i), k, false});
-    }
-  std::sort(out.begin(), out.end(), [](const ContactPair& a, const ContactPair& b) {
-    return a.i != b.i ? a.i < b.i : a.k < b.k;
-  });
+  // rows of a half list: cut for equal shares of its pairs (triangle_bound)
+  detail::in_blocks(
+      ff.rows(), k_candidate_rows_per_thread, out,
+      [&](std::size_t r0, std::size_t r1, std::vector<ContactPair>& mine) {
+        for (std::size_t i = r0; i < r1; ++i)
+          for (std::uint32_t n = ff.start[i]; n < ff.start[i + 1]; ++n) {
+            const std::uint32_t k = ff.k[n];
+            if (box.min_image(x[i] - x[k]).squaredNorm() < reach2)
+              mine.push_back({static_cast<std::uint32_t>(i), k, false});
+          }
+        // each block's rows sorted apart: the blocks hold ascending ranges of i
+        std::sort(mine.begin(), mine.end(),
+                  [](const ContactPair& a, const ContactPair& b) { return a.i != b.i ? a.i < b.i : a.k < b.k; });
+      },
+      &detail::triangle_bound);
 }
 
 void contact_candidates(const std::vector<ContactPair>& ff_near, const std::vector<IndexPair>& fw,
                         const std::vector<Vec3>& x, const WallParticles& walls, const Box& box, double radius,
                         double margin, std::vector<ContactPair>& out) {
-  out.clear();
   const double reach = 2.0 * radius + margin, reach2 = reach * reach;
-  for (const ContactPair& c : ff_near)
-    if (box.min_image(x[c.i] - x[c.k]).squaredNorm() < reach2) out.push_back(c);
+  detail::in_blocks(ff_near.size(), k_candidate_pairs_per_thread, out,
+                    [&](std::size_t lo, std::size_t hi, std::vector<ContactPair>& mine) {
+                      for (std::size_t n = lo; n < hi; ++n) {
+                        const ContactPair& c = ff_near[n];
+                        if (box.min_image(x[c.i] - x[c.k]).squaredNorm() < reach2) mine.push_back(c);
+                      }
+                    });
   for (const auto& [i, k] : fw)
     if (box.min_image(x[i] - walls.x[k]).squaredNorm() < reach2) out.push_back({i, k, true});
 }
