@@ -6,9 +6,12 @@
 #include <vector>
 
 #include "mrf/neighbors/cell_list.hpp"
+#include "parallel_blocks.hpp"
 
 namespace mrf {
 namespace {
+
+constexpr std::size_t k_spheres_per_thread = 1000;  // the least a thread takes
 
 std::uint32_t root(std::vector<std::uint32_t>& parent, std::uint32_t i) {
   while (parent[i] != i) i = parent[i] = parent[parent[i]];  // path halving
@@ -29,12 +32,23 @@ ClusterStats cluster_stats(const ShearCell& cell, double radius, double touch) {
   const MinImageYZ mi(cell.box);
   std::vector<std::uint32_t> parent(n);
   std::iota(parent.begin(), parent.end(), 0u);
-  for (std::uint32_t i = 0; i < n; ++i)
-    grid.for_each_candidate(x[i], [&](std::uint32_t j) {
-      if (j <= i || mi.norm2(x[i], x[j]) >= reach2) return;
-      const std::uint32_t a = root(parent, i), b = root(parent, j);
-      if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    });
+  // The touching pairs found by blocks of spheres on threads (in_blocks;
+  // half rows, j > i, cut by triangle_bound), joined serially: the clusters
+  // do not depend on the order of the joins.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> touching_pairs;
+  detail::in_blocks(
+      n, k_spheres_per_thread, touching_pairs,
+      [&](std::size_t lo, std::size_t hi, std::vector<std::pair<std::uint32_t, std::uint32_t>>& mine) {
+        for (auto i = static_cast<std::uint32_t>(lo); i < hi; ++i)
+          grid.for_each_candidate(x[i], [&](std::uint32_t j) {
+            if (j > i && mi.norm2(x[i], x[j]) < reach2) mine.emplace_back(i, j);
+          });
+      },
+      &detail::triangle_bound);
+  for (const auto& [i, j] : touching_pairs) {
+    const std::uint32_t a = root(parent, i), b = root(parent, j);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
   // which walls each cluster touches: bit 1 the lower (side -1), bit 2 the upper
   std::vector<std::uint8_t> walls(n, 0);
   for (std::size_t w = 0; w < cell.walls.size(); ++w)
