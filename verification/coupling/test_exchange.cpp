@@ -11,6 +11,7 @@
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "mrf/coupling/exchange.hpp"
@@ -74,6 +75,47 @@ TEST(CouplingExchange, PairsAreTheSameOnAnyNumberOfThreads) {
   EXPECT_TRUE(std::is_sorted(one.begin(), one.end(), [](const CouplingPair& x, const CouplingPair& y) {
     return x.i != y.i ? x.i < y.i : x.a < y.a;
   }));
+}
+
+// The Shepard sums, their rate and the buoyancy run on threads by blocks of
+// whole DEM runs of the pairs (each DEM particle's sums in one block, in
+// the serial order): the same bit for bit on 1, 2 and 3 threads, above the
+// block threshold (8192 pairs).
+TEST(CouplingExchange, ShepardSumsAreTheSameOnAnyNumberOfThreads) {
+  const FluidCell c = make_cell();
+  const auto dem = random_points(2500, -0.5 * c.box.gap, 0.5 * c.box.gap, c.box, 7);
+  const auto pairs = coupling_pairs(dem, c.fluid.x, c.box, c.h);
+  ASSERT_GT(pairs.size(), 3u * 8192u);
+  const std::size_t na = c.fluid.size();
+  std::vector<double> rho(na), eps(na);
+  std::vector<Vec3> v(na), acc(na);
+  for (std::size_t a = 0; a < na; ++a) {  // smooth, non-uniform fields
+    const Vec3& x = c.fluid.x[a];
+    rho[a] = 1000.0 * (1.0 + 0.01 * std::sin(x.y() / kDx));
+    eps[a] = 0.7 + 0.2 * std::cos(x.z() / kDx);
+    v[a] = Vec3(std::sin(x.x() / kDx), 0.1, std::cos(x.y() / kDx));
+    acc[a] = Vec3(0.3, std::cos(x.z() / kDx), -0.2);
+  }
+  const std::vector<Vec3> c_dem(dem.size(), Vec3(0.1, -0.2, 0.3));
+  const int saved = omp_get_max_threads();
+  auto all = [&](int t) {
+    omp_set_num_threads(t);
+    const ShepardField sh = shepard_interpolate(dem.size(), pairs, c.mass, rho, v, eps);
+    return std::make_tuple(sh, shepard_rate(pairs, c.mass, rho, v, sh, c_dem),
+                           generalised_buoyancy(dem.size(), pairs, c.mass, sh.s, acc, kVp));
+  };
+  const auto one = all(1);
+  for (int t : {2, 3}) {
+    const auto many = all(t);
+    for (std::size_t i = 0; i < dem.size(); ++i) {
+      ASSERT_EQ(std::get<0>(many).s[i], std::get<0>(one).s[i]) << t << " threads, DEM " << i;
+      ASSERT_EQ(std::get<0>(many).u[i], std::get<0>(one).u[i]) << t << " threads, DEM " << i;
+      ASSERT_EQ(std::get<0>(many).eps[i], std::get<0>(one).eps[i]) << t << " threads, DEM " << i;
+      ASSERT_EQ(std::get<1>(many)[i], std::get<1>(one)[i]) << t << " threads, DEM " << i;
+      ASSERT_EQ(std::get<2>(many)[i], std::get<2>(one)[i]) << t << " threads, DEM " << i;
+    }
+  }
+  omp_set_num_threads(saved);
 }
 
 // shepard_rate is the time derivative of the Shepard interpolant at DEM
