@@ -10,7 +10,7 @@
 #include "mrf/neighbors/cell_list.hpp"
 #include "mrf/neighbors/verlet_list.hpp"
 #include "parallel_blocks.hpp"
-#include "runs.hpp"
+#include "coupling/dem_runs.hpp"
 
 namespace mrf {
 
@@ -155,16 +155,7 @@ std::vector<CouplingPair> coupling_pairs(const std::vector<Vec3>& dem_x, const s
   return out;
 }
 
-namespace {
-// the runs of pairs of one DEM particle (pairs come sorted by i): a sum
-// over a run is held in registers and added into its array once; on
-// threads by blocks of whole runs (the same sums whatever the threads)
-constexpr std::size_t k_exchange_pairs_per_thread = 8192;
-template <class Run>
-void by_dem_runs(const std::vector<CouplingPair>& pairs, Run run) {
-  detail::for_each_run_on_threads(pairs, [](const CouplingPair& p) { return p.i; }, k_exchange_pairs_per_thread, run);
-}
-}  // namespace
+using detail::by_dem_runs;
 
 PorosityField porosity_at_fluid(std::size_t n_sph, double particle_volume, const std::vector<CouplingPair>& pairs,
                                 double floor) {

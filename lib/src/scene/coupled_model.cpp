@@ -17,6 +17,7 @@
 #include "mrf/scene/dem_model.hpp"
 #include "mrf/scene/fluid_only.hpp"
 #include "mrf/scene/run_series.hpp"
+#include "coupling/dem_runs.hpp"
 
 namespace mrf {
 
@@ -233,11 +234,17 @@ void CoupledModel::prepare_coupling(const std::vector<Vec3>& a_fluid) {
   for (const CouplingPair& q : pairs_) omega[q.a] += q.w / shepard_.s[q.i];
   std::vector<Vec3> acc(n, Vec3::Zero()), a_pv(nf);
   std::vector<double> inv_m(n, 0.0);
-  for (const CouplingPair& q : pairs_) {
-    const double w = fluid_.mass * q.w / rho[q.a];  // Shepard weight (m/rho_a) W_ia
-    acc[q.i] += w * a_fluid[q.a];
-    inv_m[q.i] += w * omega[q.a] / rho[q.a];
-  }
+  detail::by_dem_runs(pairs_, [&](std::uint32_t i, std::size_t first, std::size_t last) {
+    Vec3 acc_i = acc[i];
+    double inv_m_i = inv_m[i];
+    for (std::size_t e = first; e < last; ++e) {
+      const CouplingPair& q = pairs_[e];
+      const double w = fluid_.mass * q.w / rho[q.a];  // Shepard weight (m/rho_a) W_ia
+      acc_i += w * a_fluid[q.a];
+      inv_m_i += w * omega[q.a] / rho[q.a];
+    }
+    acc[i] = acc_i, inv_m[i] = inv_m_i;
+  });
   for (std::size_t b = 0; b < nf; ++b) a_pv[b] = a_fluid[b] - g_body - fluid_.fluid.a_ext[b];
   buoyancy_ = generalised_buoyancy(n, pairs_, fluid_.mass, shepard_.s, a_pv, sphere_volume(p_.radius));
   const DiFeliceDrag dd{2.0 * p_.radius, fluid_.params.density, fluid_.params.viscosity};
