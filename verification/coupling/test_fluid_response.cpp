@@ -3,6 +3,7 @@
 // pair list directly: the product, its symmetry, C_ii and C_ik, and the
 // product restricted to some rows.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -107,6 +108,36 @@ TEST(FluidResponse, RowsGiveTheRowsOfTheFullProduct) {
     else
       EXPECT_EQ(part[i].norm(), 0.0) << i;
   }
+}
+
+// set() builds the entries by blocks of DEM rows on threads, joined in
+// order: on 1, 2 and 3 threads the diagonal, the couplings and the product
+// are the same bit for bit (above the block threshold of 8192 pairs).
+TEST(FluidResponse, TheSameOnAnyNumberOfThreads) {
+  Coupled u = make_setup(1500, 11);
+  ASSERT_GT(u.pairs.size(), 3u * 8192u);
+  std::vector<Vec3> f(u.dem.size());
+  for (std::size_t i = 0; i < f.size(); ++i) f[i] = Vec3(std::sin(static_cast<double>(i)), std::cos(2.0 * static_cast<double>(i)), 0.5);
+  const int saved = omp_get_max_threads();
+  auto run = [&](int t) {
+    omp_set_num_threads(t);
+    FluidResponse r;
+    r.set(u.dem.size(), u.pairs, u.s, u.rho, u.mass);
+    std::vector<Vec3> y(u.dem.size(), Vec3::Zero());
+    r.add(f, 1.0, y);
+    std::vector<double> d;
+    for (std::size_t i = 0; i < u.dem.size(); ++i) d.push_back(r.diagonal(i));
+    for (std::size_t i = 0; i + 1 < u.dem.size(); i += 7) d.push_back(r.coupling(i, i + 1));
+    return std::make_pair(y, d);
+  };
+  const auto one = run(1);
+  for (int t : {2, 3}) {
+    const auto many = run(t);
+    for (std::size_t i = 0; i < one.first.size(); ++i) ASSERT_EQ(many.first[i], one.first[i]) << t << " threads, " << i;
+    for (std::size_t k = 0; k < one.second.size(); ++k) ASSERT_EQ(many.second[k], one.second[k]) << t << " threads, " << k;
+  }
+  omp_set_num_threads(saved);
+  EXPECT_GT(largest(one.first), 0.0);
 }
 
 }  // namespace

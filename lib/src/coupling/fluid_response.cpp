@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "mrf/neighbors/cell_list.hpp"
+#include "coupling/dem_runs.hpp"
 
 namespace mrf {
 
@@ -15,31 +16,56 @@ void FluidResponse::set(std::size_t n_dem, const std::vector<CouplingPair>& pair
   // same buffers.
   const std::size_t na = rho.size();
   mass_ = mass;
-  a_.clear();
-  scatter_.clear();
-  a_.reserve(pairs.size());
-  scatter_.reserve(pairs.size());
   start_.assign(n_dem + 1, 0);
   diag_.assign(n_dem, 0.0);
-  rstart_.assign(na + 1, 0);
-  std::size_t next = 0;
-  for (std::size_t i = 0; i < n_dem; ++i) {
-    const std::size_t row = a_.size();
-    for (; next < pairs.size() && pairs[next].i == i; ++next) {
-      const CouplingPair& q = pairs[next];
-      const double sc = q.w / (rho[q.a] * s[i]);
-      if (a_.size() > row && a_.back() == q.a) {
-        scatter_.back() += sc;
-      } else {
-        if (a_.size() > row && a_.back() > q.a) throw std::logic_error("FluidResponse::set: pairs not sorted by (i, a)");
-        a_.push_back(q.a);
-        scatter_.push_back(sc);
-        ++rstart_[q.a + 1];
+  // Blocks of DEM rows on threads, each filling its own entries (row ends
+  // counted within the block, shifted when the blocks are joined in order):
+  // the serial entries whatever the threads.
+  const int blocks = detail::block_count(pairs.size(), detail::k_exchange_pairs_per_thread);
+  part_a_.resize(static_cast<std::size_t>(blocks));
+  part_scatter_.resize(static_cast<std::size_t>(blocks));
+  std::vector<char> unsorted(static_cast<std::size_t>(blocks), 0);
+  detail::for_blocks(n_dem, blocks, [&](std::size_t blk, std::size_t lo, std::size_t hi) {
+    std::vector<std::uint32_t>& a = blk == 0 ? a_ : part_a_[blk];
+    std::vector<double>& sc_of = blk == 0 ? scatter_ : part_scatter_[blk];
+    a.clear();
+    sc_of.clear();
+    std::size_t next = static_cast<std::size_t>(
+        std::lower_bound(pairs.begin(), pairs.end(), lo, [](const CouplingPair& q, std::size_t i) { return q.i < i; }) -
+        pairs.begin());
+    for (std::size_t i = lo; i < hi; ++i) {
+      const std::size_t row = a.size();
+      for (; next < pairs.size() && pairs[next].i == i; ++next) {
+        const CouplingPair& q = pairs[next];
+        const double sc = q.w / (rho[q.a] * s[i]);
+        if (a.size() > row && a.back() == q.a) {
+          sc_of.back() += sc;
+        } else {
+          if (a.size() > row && a.back() > q.a) unsorted[blk] = 1;
+          a.push_back(q.a);
+          sc_of.push_back(sc);
+        }
       }
+      start_[i + 1] = static_cast<std::uint32_t>(a.size());  // checked below, with the joined size
+      for (std::size_t e = row; e < a.size(); ++e) diag_[i] += mass * sc_of[e] * sc_of[e];
     }
-    start_[i + 1] = checked_index(a_.size(), "fluid response");
-    for (std::size_t e = row; e < a_.size(); ++e) diag_[i] += mass * scatter_[e] * scatter_[e];
+  });
+  if (std::find(unsorted.begin(), unsorted.end(), 1) != unsorted.end())
+    throw std::logic_error("FluidResponse::set: pairs not sorted by (i, a)");
+  std::size_t total = a_.size();
+  for (int blk = 1; blk < blocks; ++blk) total += part_a_[static_cast<std::size_t>(blk)].size();
+  checked_index(total, "fluid response");
+  for (int blk = 1; blk < blocks; ++blk) {
+    const auto b = static_cast<std::size_t>(blk);
+    const std::size_t offset = a_.size();
+    a_.insert(a_.end(), part_a_[b].begin(), part_a_[b].end());
+    scatter_.insert(scatter_.end(), part_scatter_[b].begin(), part_scatter_[b].end());
+    for (std::size_t i = detail::block_bound(n_dem, b, static_cast<std::size_t>(blocks));
+         i < detail::block_bound(n_dem, b + 1, static_cast<std::size_t>(blocks)); ++i)
+      start_[i + 1] = static_cast<std::uint32_t>(start_[i + 1] + offset);
   }
+  rstart_.assign(na + 1, 0);
+  for (const std::uint32_t b : a_) ++rstart_[b + 1];
   // The same entries by SPH particle (CSR over a), so that the scatter is a
   // gather too: both passes run on threads without write conflicts, each
   // sum in a fixed order.

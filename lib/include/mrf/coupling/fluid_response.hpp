@@ -48,6 +48,8 @@ class FluidResponse final : public MobilityCoupling {
   std::vector<std::uint32_t> rstart_, rdem_;  // the entries by SPH particle: DEM index
   std::vector<double> rscatter_;              // and scatter weight
   std::vector<std::uint32_t> fill_;           // scratch of set(): the next free slot per SPH particle
+  std::vector<std::vector<std::uint32_t>> part_a_;  // scratch of set(): the entries of each block of rows but the first
+  std::vector<std::vector<double>> part_scatter_;
   // Threads only where there is work for them (a parallel region costs a
   // few microseconds); the choice depends on the pairs alone.
   static constexpr std::size_t k_entries_per_thread = 20000;
