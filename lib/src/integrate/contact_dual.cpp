@@ -135,18 +135,18 @@ void ContactDual::apply(const std::vector<ContactPair>& pairs, const std::vector
         pdisp_[e.k] -= e.mob_k * g;  // a wall pair: the spare row, 0 * g
       }
     } else {
-    detail::for_blocks(ns, sphere_blocks_, [&](std::size_t, std::size_t lo, std::size_t hi) {
-      for (std::size_t t = lo; t < hi; ++t) {
-        const std::uint32_t i = act_particles_[t];
-        const double mi = mob[i];
-        Vec3 d = Vec3::Zero();
-        for (std::uint32_t e = row_start_[i]; e < row_start_[i + 1]; ++e) {
-          const SphereEntry& en = row_entry_[e];
-          d += mi * (p[en.a] * en.sn);
+      detail::for_blocks(ns, sphere_blocks_, [&](std::size_t, std::size_t lo, std::size_t hi) {
+        for (std::size_t t = lo; t < hi; ++t) {
+          const std::uint32_t i = act_particles_[t];
+          const double mi = mob[i];
+          Vec3 d = Vec3::Zero();
+          for (std::uint32_t e = row_start_[i]; e < row_start_[i + 1]; ++e) {
+            const SphereEntry& en = row_entry_[e];
+            d += mi * (p[en.a] * en.sn);
+          }
+          pdisp_[i] = d;
         }
-        pdisp_[i] = d;
-      }
-    });
+      });
     }
     detail::for_blocks(m, contact_blocks, [&](std::size_t, std::size_t lo, std::size_t hi) {
       for (std::size_t a = lo; a < hi; ++a) {
@@ -168,20 +168,20 @@ void ContactDual::apply(const std::vector<ContactPair>& pairs, const std::vector
       if (!c.wall) s_[c.k] -= g;
     }
   } else {
-  detail::for_blocks(ns, sphere_blocks_, [&](std::size_t, std::size_t lo, std::size_t hi) {
-    for (std::size_t t = lo; t < hi; ++t) {
-      const std::uint32_t i = act_particles_[t];
-      Vec3 d = Vec3::Zero(), si = Vec3::Zero();
-      for (std::uint32_t e = row_start_[i]; e < row_start_[i + 1]; ++e) {
-        const SphereEntry& en = row_entry_[e];
-        const Vec3 g = p[en.a] * en.sn;
-        d += mob[i] * g;
-        si += g;
+    detail::for_blocks(ns, sphere_blocks_, [&](std::size_t, std::size_t lo, std::size_t hi) {
+      for (std::size_t t = lo; t < hi; ++t) {
+        const std::uint32_t i = act_particles_[t];
+        Vec3 d = Vec3::Zero(), si = Vec3::Zero();
+        for (std::uint32_t e = row_start_[i]; e < row_start_[i + 1]; ++e) {
+          const SphereEntry& en = row_entry_[e];
+          const Vec3 g = p[en.a] * en.sn;
+          d += mob[i] * g;
+          si += g;
+        }
+        disp_[i] = d;
+        s_[i] = si;
       }
-      disp_[i] = d;
-      s_[i] = si;
-    }
-  });
+    });
   }
   coupled_->add(s_, coupled_scale_, disp_, &act_particles_);
   detail::for_blocks(m, contact_blocks, [&](std::size_t, std::size_t lo, std::size_t hi) {
