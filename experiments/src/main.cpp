@@ -2,7 +2,7 @@
 //   mrf run SCENE.toml [--set section.key=value]... [--out DIR] [--quiet] [--resume] [--checkpoint-every S]
 //   mrf criterion SWEEP_DIR|RUN_DIR [--thresholds FILE]
 //   mrf quasistatic SCENE.toml [--set k=v]... [--out DIR] [--increment D] [--tol T] [--strain S] [--warmup W]
-//             [--cutoff R] [--no-affine] [--resume] [--checkpoint-every S]
+//             [--cutoff R] [--no-affine] [--resume] [--branch-from CHECKPOINT] [--checkpoint-every S]
 //   mrf sweep SWEEP.toml [--out DIR] [--quiet] [--estimate | --list | --collect] [--point K | --rank R --ranks K]
 //             [--checkpoint-every S] [--archive DIR]   (mpirun -n K: master-worker schedule)
 // Exit status: 0 done, 2 bad input, 3 numerical failure or refused
@@ -219,6 +219,9 @@ int main(int argc, char** argv) {
   qs->add_option("--max-iterations", qo.max_iterations, "FIRE iterations per minimisation")->capture_default_str();
   qs->add_flag("--no-affine", no_affine, "free particles not displaced affinely before each minimisation");
   qs->add_flag("--quiet", qs_cli.quiet, "no progress on stderr");
+  qs->add_option("--branch-from", qs_cli.branch_from,
+                 "start from another run's checkpoint.bin (same scene and settings but --tol): a pathwise "
+                 "tolerance test from one minimum");
   qs->add_flag("--resume", qs_cli.resume,
                "continue from OUT/checkpoint.bin (same scene and options; a larger --strain extends a finished run)");
   qs->add_option("--checkpoint-every", qs_cli.checkpoint_seconds,

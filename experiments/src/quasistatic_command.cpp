@@ -10,11 +10,15 @@
 // written; --resume continues from the checkpoint, bit for bit, and with a
 // larger --strain extends a finished run. The checkpoint names its scene
 // (scene_id) and options; another scene or increment, tolerance, affine
-// start or cut-off is refused.
+// start or cut-off is refused. --branch-from CHECKPOINT starts a new run
+// (a new --out) from another run's checkpoint at another --tol, everything
+// else the same: both tolerances then go on from one minimum, a pathwise
+// comparison; OUT/branch.json and summary.json's branched_from say where.
 #include "quasistatic_command.hpp"
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -59,7 +63,30 @@ int quasistatic_command(const std::string& scene_path, const std::vector<std::st
   const mrf::QuasistaticOptions& opt = run.options();
   const std::string id = mrf::scene_id(scene.config), ckpt = out + "/checkpoint.bin";
   std::filesystem::create_directories(out);
-  if (cli.resume && std::filesystem::exists(ckpt)) {
+  const bool resuming = cli.resume && std::filesystem::exists(ckpt);
+  if (!cli.branch_from.empty() && !resuming) {
+    if (std::filesystem::exists(ckpt))
+      throw mrf::InputError("--out", out, "", "holds a checkpoint of an earlier run: a branch starts in a new --out");
+    if (!std::filesystem::exists(cli.branch_from))
+      throw mrf::InputError("--branch-from", cli.branch_from, "", "no such checkpoint");
+    mrf::ArchiveReader in(cli.branch_from);
+    std::string saved;
+    in.get(saved);
+    if (saved != id)
+      throw mrf::NumericalError("checkpoint " + cli.branch_from + " is of scene " + saved + ", this scene (with its --set) is " +
+                                id + ": a branch takes the same scene and overrides");
+    run.load(in, true);
+    in.expect_end();
+    nlohmann::ordered_json b;  // what summary.json reports of the branch, also after a --resume of it
+    b["checkpoint"] = cli.branch_from;
+    b["increment"] = run.next_increment();
+    b["strain"] = static_cast<double>(run.next_increment()) * opt.strain_increment;
+    mrf::write_file_atomic(out + "/branch.json", b.dump(2) + "\n");
+    if (!cli.quiet)
+      std::fprintf(stderr, "mrf quasistatic: branched from %s at increment %zu (minima before it are that run's)\n",
+                   cli.branch_from.c_str(), run.next_increment());
+  }
+  if (resuming) {
     mrf::ArchiveReader in(ckpt);
     std::string saved;
     in.get(saved);
@@ -129,6 +156,8 @@ int quasistatic_command(const std::string& scene_path, const std::vector<std::st
   j["force_evaluations"] = r.force_evaluations;
   j["list_builds"] = r.list_builds;
   j["wall_seconds"] = r.wall_seconds;
+  if (std::ifstream branch(out + "/branch.json"); branch)  // minima up to its increment are the parent run's
+    j["branched_from"] = nlohmann::ordered_json::parse(branch);
   j["seed"] = scene.config.seed;
   j["version"] = mrf::version();
   j["git_revision"] = mrf::git_revision();

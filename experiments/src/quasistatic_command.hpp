@@ -7,10 +7,11 @@
 struct QuasistaticCliOptions {
   bool quiet = false;
   bool resume = false;            // continue from OUT/checkpoint.bin
+  std::string branch_from;        // or start from another run's checkpoint, at this run's tolerance
   double checkpoint_seconds = 60; // wall seconds between checkpoints (0: only at the end)
 };
 
 // `mrf quasistatic SCENE [--set k=v]... [--out DIR] [--increment D] [--tol T] [--no-affine] [--cutoff R]
-//  [--resume] [--checkpoint-every S]` (see quasistatic_command.cpp).
+//  [--resume] [--branch-from CHECKPOINT] [--checkpoint-every S]` (see quasistatic_command.cpp).
 int quasistatic_command(const std::string& scene, const std::vector<std::string>& sets, std::string out,
                         const mrf::QuasistaticOptions& opt, const QuasistaticCliOptions& cli);

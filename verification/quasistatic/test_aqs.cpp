@@ -210,6 +210,59 @@ TEST(QuasistaticResume, RestoredRunContinuesBitForBitAndExtends) {
   }
 }
 
+// A branch (load with branch = true) takes another run's checkpoint at
+// another force tolerance: the minima before it are that run's, every later
+// one meets the branch's tolerance, and a branch at the same tolerance
+// continues the run bit for bit. Without branch the tolerance is refused.
+TEST(QuasistaticResume, BranchAtAnotherToleranceStartsFromTheSameMinimum) {
+  const LoadedScene scene = test::scene({"contact.youngs_modulus=\"2 GPa\""});
+  QuasistaticOptions o = smoke_options();
+  o.strain = 3e-3;
+  o.force_tol = 1e-4;
+  test::TempDir dir("aqs_branch");
+  const std::string ckpt = (dir.path() / "checkpoint.bin").string();
+  QuasistaticRun parent = quasistatic_run(scene, o);
+  for (int k = 0; k < 2; ++k) parent.step();
+  {
+    ArchiveWriter w(ckpt);
+    parent.save(w);
+    w.close();
+  }
+  while (!parent.done()) parent.step();
+  const QuasistaticResult straight = parent.finish();
+  auto branch = [&](double tol) {
+    QuasistaticOptions b = o;
+    b.force_tol = tol;
+    QuasistaticRun run = quasistatic_run(scene, b);
+    ArchiveReader in(ckpt);
+    run.load(in, true);
+    in.expect_end();
+    EXPECT_EQ(run.next_increment(), 2u);
+    while (!run.done()) run.step();
+    return run.finish();
+  };
+  const QuasistaticResult same = branch(o.force_tol);
+  ASSERT_EQ(same.strain.size(), straight.strain.size());
+  for (std::size_t k = 0; k < same.strain.size(); ++k) EXPECT_EQ(same.stress_wall[k], straight.stress_wall[k]) << k;
+  const QuasistaticResult tight = branch(1e-6);
+  ASSERT_EQ(tight.strain.size(), straight.strain.size());
+  for (std::size_t k = 0; k < 2; ++k) EXPECT_EQ(tight.stress_wall[k], straight.stress_wall[k]) << "minimum " << k;
+  for (std::size_t k = 2; k < tight.strain.size(); ++k) {
+    EXPECT_LT(tight.max_force[k], 1e-6 * tight.force_scale) << "minimum " << k;
+    EXPECT_NE(tight.stress_wall[k], straight.stress_wall[k]) << "minimum " << k << ": the tolerance must matter";
+  }
+  QuasistaticOptions t = o;
+  t.force_tol = 1e-6;
+  QuasistaticRun refused = quasistatic_run(scene, t);
+  try {
+    ArchiveReader in(ckpt);
+    refused.load(in);
+    FAIL() << "no error";
+  } catch (const NumericalError& err) {
+    EXPECT_NE(std::string(err.what()).find("quasistatic.force_tol"), std::string::npos) << err.what();
+  }
+}
+
 TEST(QuasistaticOptions, BadValuesNameTheirKey) {
   const auto key_of = [](QuasistaticOptions o) {
     try {

@@ -239,7 +239,7 @@ void QuasistaticRun::save(ArchiveWriter& out) const {
   out.put(wall_seconds());
 }
 
-void QuasistaticRun::load(ArchiveReader& in) {
+void QuasistaticRun::load(ArchiveReader& in, bool branch) {
   double increment = 0, tol = 0, cutoff = 0;
   std::uint8_t affine = 0;
   in.io(increment, tol, affine, cutoff);
@@ -248,12 +248,13 @@ void QuasistaticRun::load(ArchiveReader& in) {
                          ", this run asks for " + now + ": start a new run (another --out) or resume with the same value");
   };
   if (increment != o_.strain_increment) refuse("strain_increment", format_short(increment), format_short(o_.strain_increment));
-  if (tol != o_.force_tol) refuse("force_tol", format_short(tol), format_short(o_.force_tol));
+  if (tol != o_.force_tol && !branch) refuse("force_tol", format_short(tol), format_short(o_.force_tol));
   if ((affine != 0) != o_.affine) refuse("affine", affine ? "on" : "off", o_.affine ? "on" : "off");
   if (cutoff != o_.dipole_cutoff) refuse("dipole_cutoff", format_short(cutoff) + " m", format_short(o_.dipole_cutoff) + " m");
   const std::size_t n_free = s_.cell.free.size(), n_wall = s_.cell.walls.size();
   serialize(in, *this);
   in.get(seconds_before_);
+  if (branch) seconds_before_ = 0;
   t0_ = std::chrono::steady_clock::now();
   if (s_.cell.free.x.size() != n_free || s_.cell.walls.x.size() != n_wall)
     throw NumericalError("checkpoint " + in.path() + " holds " + std::to_string(s_.cell.free.x.size()) + " free and " +

@@ -167,8 +167,13 @@ class QuasistaticRun {
   // state: load() refuses (NumericalError naming the option and both values)
   // a checkpoint written with others. The total strain may differ: a run
   // is extended by resuming it with a larger one.
+  // branch: a new run from another run's checkpoint, whose force tolerance
+  // may differ (the others may not): its minima so far are the other
+  // run's, each later one at this run's tolerance, so the two tolerances
+  // are compared along one path from the same minimum; its wall time
+  // starts at 0.
   void save(ArchiveWriter& out) const;
-  void load(ArchiveReader& in);
+  void load(ArchiveReader& in, bool branch = false);
 
  private:
   template <class Archive, class Self>
