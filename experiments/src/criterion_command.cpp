@@ -64,11 +64,37 @@ int run_directory(const std::string& dir, const Thresholds* t) {
                           "the criterion is read off a model-1 (dem_stokes) run");
   const double total = j.at("stress_total").get<double>();
   const double share = j.at("stress_fluid").get<double>() / total;
+  const auto num = [&j](const char* k) { return j.contains(k) && j[k].is_number() ? j[k].get<double>() : 0.0; };
+  if (j.contains("stress_virial_total") && j.contains("stress_virial_contact")) {
+    mrf::Model1Stresses st{total, num("stress_total_err"), num("stress_virial_total"), num("stress_virial_total_err"),
+                           num("stress_virial_contact"), num("stress_virial_contact_err"), num("volume_fraction")};
+    const auto sf = mrf::predicted_shortfall(st);
+    const mrf::RunConditions rc{st.volume_fraction, num("radius") > 0 ? num("gap") / num("radius") : 0.0,
+                                num("mason"), num("stokes_number"), num("reynolds_number")};
+    std::printf("%s: model 1 (dem_stokes) predicted shortfall against the two-way DD model\n"
+                "  delta = 1 - tau_wall/tau_ref = %.3f +- %.3f -> model 1 %s within 10 %%, %s within 20 %%\n"
+                "  tau_wall = %.4g +- %.2g Pa; tau_ref = tau_volume + (g - 1) max(tau_contact, 0) = %.4g +- %.2g Pa\n"
+                "  m = 1 - tau_wall/tau_volume = %.3f +- %.3f; tau_contact = %.4g +- %.2g Pa; g(phi = %.3g) = %.3f\n"
+                "  St = %.3g, Re_p = %.3g, Mn = %.3g, gap/R = %s, gap-spanning fraction = %s\n",
+                dir.c_str(), sf.value, sf.err, mrf::shortfall_adequate(sf, 0.1) ? "ADEQUATE" : "NOT adequate",
+                mrf::shortfall_adequate(sf, 0.2) ? "ADEQUATE" : "NOT adequate", st.wall, st.wall_err, sf.reference,
+                sf.reference_err, sf.mismatch, sf.mismatch_err, st.contact, st.contact_err, st.volume_fraction,
+                sf.drag_ratio, rc.stokes, rc.reynolds, rc.mason,
+                rc.gap_over_radius > 0 ? std::to_string(rc.gap_over_radius).c_str() : "unknown (no radius in summary.json)",
+                j.contains("spanning_fraction") ? std::to_string(num("spanning_fraction")).c_str() : "not measured");
+    const mrf::CriterionDomain dom;
+    std::printf("  tested on (experiments/sweeps/criterion_heldout.toml): phi %.2g-%.2g, gap/R %.3g-%.3g, Mn %.2g-%.2g, "
+                "St <= %.2g, Re_p <= %.2g\n",
+                dom.phi_min, dom.phi_max, dom.gap_over_radius_min, dom.gap_over_radius_max, dom.mason_min,
+                dom.mason_max, dom.stokes_max, dom.reynolds_max);
+    for (const auto& w : mrf::outside_domain(rc, dom))
+      std::printf("  OUTSIDE the tested range: %s (the verdict is an extrapolation)\n", w.c_str());
+  }
   if (j.contains("stress_virial_total")) {
     const double m = 1.0 - total / j["stress_virial_total"].get<double>();
     const double re = j.at("reynolds_number").get<double>();
-    std::printf("%s: self-consistency mismatch m = 1 - tau_wall/tau_volume = %.3f, Re_p = %.3g -> model 1 %s within "
-                "10 %%, %s within 20 %% of the two-way model (|m| < level and Re_p < %.2g)\n",
+    std::printf("%s: [earlier, provisional rule] m = %.3f, Re_p = %.3g -> model 1 %s within "
+                "10 %%, %s within 20 %% (|m| < level and Re_p < %.2g)\n",
                 dir.c_str(), m, re, mrf::consistency_adequate(m, re, 0.1) ? "ADEQUATE" : "NOT adequate",
                 mrf::consistency_adequate(m, re, 0.2) ? "ADEQUATE" : "NOT adequate", mrf::k_criterion_max_reynolds);
   }
@@ -78,6 +104,63 @@ int run_directory(const std::string& dir, const Thresholds* t) {
   }
   print_verdict(dir.c_str(), share, *t);
   return 0;
+}
+
+// The pre-registered criterion scored against model 3 (mrf::score_criterion)
+// as criterion.json holds it, with one line per level on stdout.
+ordered_json preregistered_json(const mrf::CriterionScore& sc) {
+  ordered_json rows = ordered_json::array();
+  for (const auto& p : sc.points) {
+    ordered_json r{{"curve", p.curve},
+                   {"mason", p.mason},
+                   {"deviation", p.deviation},
+                   {"deviation_err", p.deviation_err},
+                   {"shortfall", p.shortfall.value},
+                   {"shortfall_err", p.shortfall.err},
+                   {"mismatch", p.shortfall.mismatch},
+                   {"mismatch_err", p.shortfall.mismatch_err},
+                   {"drag_ratio", p.shortfall.drag_ratio},
+                   {"volume_fraction", p.conditions.volume_fraction},
+                   {"gap_over_radius", p.conditions.gap_over_radius},
+                   {"stokes", p.conditions.stokes},
+                   {"reynolds", p.conditions.reynolds},
+                   {"seeds", p.seeds}};
+    if (!p.outside.empty()) r["outside_domain"] = p.outside;
+    for (int k = 0; k < 2; ++k) {
+      const std::string tag = k == 0 ? "_10" : "_20";
+      r["adequate" + tag] = p.adequate[k];
+      r["outcome" + tag] = mrf::to_string(p.outcome[k]);
+      r["mismatch_only_outcome" + tag] = mrf::to_string(p.mismatch_outcome[k]);
+    }
+    rows.push_back(r);
+  }
+  const auto matrix = [](const mrf::Confusion& c) {
+    return ordered_json{{"right_adequate", c.right_adequate},
+                        {"right_not_adequate", c.right_not_adequate},
+                        {"wrong_adequate", c.wrong_adequate},
+                        {"wrong_not_adequate", c.wrong_not_adequate},
+                        {"undecidable", c.undecidable},
+                        {"right_fraction", c.decidable() ? ordered_json(c.right_fraction()) : ordered_json()},
+                        {"adequate_right_fraction", c.right_adequate + c.wrong_adequate
+                                                        ? ordered_json(c.adequate_right_fraction())
+                                                        : ordered_json()}};
+  };
+  ordered_json out{{"rule", "model 1 adequate at a when |1 - tau_wall/(tau_volume + (g(phi) - 1) max(tau_contact, 0))| < a"},
+                   {"points", rows}};
+  for (int k = 0; k < 2; ++k) {
+    const std::string tag = k == 0 ? "_10" : "_20";
+    const auto& r = sc.rule[k];
+    const auto& m = sc.mismatch_only[k];
+    out["confusion" + tag] = matrix(r);
+    out["mismatch_only_confusion" + tag] = matrix(m);
+    if (!rows.empty())
+      std::printf("pre-registered criterion at %2.0f %%: %d right (%d of them adequate), %d wrong 'adequate', %d wrong "
+                  "'not adequate', %d undecidable; |m| alone: %d right, %d wrong 'adequate', %d wrong 'not adequate'\n",
+                  100 * mrf::k_criterion_levels[k], r.right_adequate + r.right_not_adequate, r.right_adequate,
+                  r.wrong_adequate, r.wrong_not_adequate, r.undecidable, m.right_adequate + m.right_not_adequate,
+                  m.wrong_adequate, m.wrong_not_adequate);
+  }
+  return out;
 }
 
 }  // namespace
@@ -176,6 +259,7 @@ int criterion_command(const std::string& path, const std::string& thresholds_pat
       out["derived_thresholds"] = {{"share_10", d["crossing_10"]["share"]}, {"share_20", d["crossing_20"]["share"]},
                                    {"mason_10", d["crossing_10"]["mason"]}, {"mason_20", d["crossing_20"]["mason"]}};
   }
+  out["preregistered_criterion"] = preregistered_json(mrf::score_criterion(curves));
   if (t && curves.count("dem_stokes")) {
     // verdict per model-1 point, and where model 3 was run too, the hit rate
     int hits = 0, tested = 0;

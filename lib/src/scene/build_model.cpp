@@ -295,7 +295,7 @@ BuiltModel build_model(const LoadedScene& scene, bool quiet) {
   for (std::size_t i = 0; i < cell.free.size(); ++i) cell.free.v[i] = couette_velocity(cell.free.x[i], c.shear_rate);
   BuiltModel b = c.model == ModelId::dem_stokes ? build_dem(scene, std::move(cell), p, quiet)
                                                 : build_coupled(scene, std::move(cell), p, quiet);
-  b.summary.extra.insert({{"dipole_cutoff", c.dipole_cutoff}, {"gap", c.gap}, {"box_ly", c.ly}, {"box_lz", c.lz}});
+  b.summary.extra.insert({{"dipole_cutoff", c.dipole_cutoff}, {"gap", c.gap}, {"radius", c.radius}, {"box_ly", c.ly}, {"box_lz", c.lz}});
   return b;
 }
 

@@ -1,11 +1,13 @@
 #include "mrf/study/criterion.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 
+#include "mrf/coupling/drag_laws.hpp"
 #include "mrf/error.hpp"
 
 namespace mrf {
@@ -49,16 +51,24 @@ SweepTable read_sweep_csv(const std::string& path) {
     s.stress = std::stod(c[col["stress_total"]]);
     s.err = std::stod(c[col["stress_total_err"]]);
     s.stress_fluid = std::stod(c[col["stress_fluid"]]);
-    if (col.count("stokes_number") && !c[col["stokes_number"]].empty()) s.stokes = std::stod(c[col["stokes_number"]]);
-    if (col.count("reynolds_number") && !c[col["reynolds_number"]].empty())
-      s.reynolds = std::stod(c[col["reynolds_number"]]);
-    if (col.count("stress_virial_total") && !c[col["stress_virial_total"]].empty())
-      s.stress_volume = std::stod(c[col["stress_virial_total"]]);
+    const auto optional = [&](const char* key, double& v) {
+      if (col.count(key) && !c[col[key]].empty()) v = std::stod(c[col[key]]);
+    };
+    optional("stokes_number", s.stokes);
+    optional("reynolds_number", s.reynolds);
+    optional("stress_virial_total", s.stress_volume);
+    optional("stress_virial_total_err", s.volume_err);
+    optional("stress_virial_contact", s.stress_contact);
+    optional("stress_virial_contact_err", s.contact_err);
     s.magnetization = std::stod(c[col["magnetization"]]);
     if (first_row) t.magnetization = s.magnetization;
     else if (t.magnetization != s.magnetization) t.magnetization = 0;  // varies from row to row
     first_row = false;
-    t.volume_fraction = std::stod(c[col["volume_fraction"]]);
+    t.volume_fraction = s.volume_fraction = std::stod(c[col["volume_fraction"]]);
+    double gap = 0, radius = 0;
+    optional("gap", gap);
+    optional("radius", radius);
+    if (radius > 0) s.gap_over_radius = gap / radius;
     if (t.viscosity == 0 && col.count("viscosity") && !c[col["viscosity"]].empty())
       t.viscosity = std::stod(c[col["viscosity"]]);
     if (t.fluid_density == 0 && col.count("fluid_density") && !c[col["fluid_density"]].empty())
@@ -136,6 +146,116 @@ Crossing first_crossing(const std::vector<Deviation>& d, double level) {
 
 bool consistency_adequate(double mismatch, double reynolds, double level) {
   return std::abs(mismatch) < level && reynolds < k_criterion_max_reynolds;
+}
+
+double difelice_over_stokes(double volume_fraction) {
+  // beta at zero slip is the Re -> 0 limit; the diameter and viscosity cancel
+  const double d = 1.0, eta = 1.0;
+  return di_felice_drag_coefficient(0.0, 1.0 - volume_fraction, d, 0.0, eta) / (3.0 * k_pi * eta * d);
+}
+
+Shortfall predicted_shortfall(const Model1Stresses& s) {
+  Shortfall r;
+  const auto rel2 = [](double err, double v) { return v != 0 ? (err / v) * (err / v) : 0.0; };
+  r.mismatch = 1.0 - s.wall / s.volume;
+  r.mismatch_err = std::abs(s.wall / s.volume) * std::sqrt(rel2(s.wall_err, s.wall) + rel2(s.volume_err, s.volume));
+  r.drag_ratio = difelice_over_stokes(s.volume_fraction);
+  const double k = r.drag_ratio - 1.0;
+  const bool drag_term = s.contact > 0;
+  r.reference = s.volume + (drag_term ? k * s.contact : 0.0);
+  r.reference_err = std::hypot(s.volume_err, drag_term ? k * s.contact_err : 0.0);
+  r.value = 1.0 - s.wall / r.reference;
+  r.err = std::abs(s.wall / r.reference) * std::sqrt(rel2(s.wall_err, s.wall) + rel2(r.reference_err, r.reference));
+  return r;
+}
+
+std::vector<std::string> outside_domain(const RunConditions& c, const CriterionDomain& d) {
+  std::vector<std::string> out;
+  const auto check = [&out](const char* name, double v, double lo, double hi) {
+    char line[96];
+    if (v < lo) std::snprintf(line, sizeof line, "%s = %.3g < %.3g", name, v, lo);
+    else if (v > hi) std::snprintf(line, sizeof line, "%s = %.3g > %.3g", name, v, hi);
+    else return;
+    out.emplace_back(line);
+  };
+  check("phi", c.volume_fraction, d.phi_min, d.phi_max);
+  if (c.gap_over_radius > 0) check("gap/R", c.gap_over_radius, d.gap_over_radius_min, d.gap_over_radius_max);
+  check("Mn", c.mason, d.mason_min, d.mason_max);
+  check("St", c.stokes, 0.0, d.stokes_max);
+  check("Re_p", c.reynolds, 0.0, d.reynolds_max);
+  return out;
+}
+
+Outcome score_verdict(bool adequate, double deviation, double deviation_err, double level) {
+  const double a = std::abs(deviation);
+  if (std::abs(a - level) < deviation_err) return Outcome::undecidable;
+  const bool within = a < level;
+  if (adequate) return within ? Outcome::right_adequate : Outcome::wrong_adequate;
+  return within ? Outcome::wrong_not_adequate : Outcome::right_not_adequate;
+}
+
+const char* to_string(Outcome o) {
+  switch (o) {
+    case Outcome::right_adequate: return "right (adequate)";
+    case Outcome::right_not_adequate: return "right (not adequate)";
+    case Outcome::wrong_adequate: return "WRONG: adequate, but model 1 is off by more";
+    case Outcome::wrong_not_adequate: return "wrong (conservative): not adequate, but model 1 is within";
+    case Outcome::undecidable: return "undecidable (|D| within one standard error of the level)";
+  }
+  return "?";
+}
+
+void Confusion::add(Outcome o) {
+  switch (o) {
+    case Outcome::right_adequate: ++right_adequate; break;
+    case Outcome::right_not_adequate: ++right_not_adequate; break;
+    case Outcome::wrong_adequate: ++wrong_adequate; break;
+    case Outcome::wrong_not_adequate: ++wrong_not_adequate; break;
+    case Outcome::undecidable: ++undecidable; break;
+  }
+}
+
+double Confusion::right_fraction() const {
+  return decidable() ? static_cast<double>(right_adequate + right_not_adequate) / decidable() : std::nan("");
+}
+
+double Confusion::adequate_right_fraction() const {
+  const int n = right_adequate + wrong_adequate;
+  return n ? static_cast<double>(right_adequate) / n : std::nan("");
+}
+
+CriterionScore score_criterion(const std::map<std::string, std::vector<FlowPoint>>& curves) {
+  CriterionScore out;
+  const std::string model1 = "dem_stokes";
+  for (const auto& [key, pts] : curves) {
+    if (key.rfind(model1, 0) != 0) continue;
+    const auto ref = curves.find("demsph_dd" + key.substr(model1.size()));
+    if (ref == curves.end()) continue;
+    for (const Deviation& d : deviation(pts, ref->second)) {
+      const FlowPoint& p = *std::find_if(pts.begin(), pts.end(), [&](const FlowPoint& x) { return x.mason == d.mason; });
+      if (p.stress_volume == 0) continue;
+      ScoredPoint sp;
+      sp.curve = key;
+      sp.mason = d.mason;
+      sp.deviation = d.value;
+      sp.deviation_err = d.err;
+      sp.shortfall = predicted_shortfall(
+          {p.stress, p.err, p.stress_volume, p.volume_err, p.stress_contact, p.contact_err, p.volume_fraction});
+      sp.conditions = {p.volume_fraction, p.gap_over_radius, p.mason, p.stokes, p.reynolds};
+      sp.seeds = p.seeds;
+      sp.outside = outside_domain(sp.conditions);
+      for (int k = 0; k < 2; ++k) {
+        const double level = k_criterion_levels[k];
+        sp.adequate[k] = shortfall_adequate(sp.shortfall, level);
+        sp.outcome[k] = score_verdict(sp.adequate[k], d.value, d.err, level);
+        sp.mismatch_outcome[k] = score_verdict(std::abs(sp.shortfall.mismatch) < level, d.value, d.err, level);
+        out.rule[k].add(sp.outcome[k]);
+        out.mismatch_only[k].add(sp.mismatch_outcome[k]);
+      }
+      out.points.push_back(sp);
+    }
+  }
+  return out;
 }
 
 CriterionVerdict apply_criterion(double share, double s10, double s20) {

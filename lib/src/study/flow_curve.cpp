@@ -21,21 +21,34 @@ std::vector<FlowPoint> seed_average(const std::vector<StressSample>& samples) {
     p.mason = mn;
     p.seeds = static_cast<int>(group.size());
     const double n = static_cast<double>(group.size());
-    double sum_err2 = 0;
+    // mean of one quantity over the seeds, its error the larger of the seed
+    // scatter / sqrt(n) and the within-run errors combined
+    const auto combine = [&](double StressSample::*value, double StressSample::*err, double& mean, double& scatter,
+                             double& within) {
+      double sum_err2 = 0;
+      mean = 0;
+      for (const auto* s : group) {
+        mean += s->*value / n;
+        sum_err2 += s->*err * (s->*err);
+      }
+      double ss = 0;
+      for (const auto* s : group) ss += (s->*value - mean) * (s->*value - mean);
+      scatter = group.size() > 1 ? std::sqrt(ss / (n - 1)) : 0.0;
+      within = std::sqrt(sum_err2) / n;
+      return std::max(within, scatter / std::sqrt(n));
+    };
     for (const auto* s : group) {
-      p.stress += s->stress / n;
       p.stress_fluid += s->stress_fluid / n;
-      p.stress_volume += s->stress_volume / n;
       p.stokes = s->stokes;
       p.reynolds = s->reynolds;
       p.magnetization = s->magnetization;
-      sum_err2 += s->err * s->err;
+      p.volume_fraction = s->volume_fraction;
+      p.gap_over_radius = s->gap_over_radius;
     }
-    double ss = 0;
-    for (const auto* s : group) ss += (s->stress - p.stress) * (s->stress - p.stress);
-    p.seed_scatter = group.size() > 1 ? std::sqrt(ss / (n - 1)) : 0.0;
-    p.within_err = std::sqrt(sum_err2) / n;
-    p.err = std::max(p.within_err, p.seed_scatter / std::sqrt(n));
+    p.err = combine(&StressSample::stress, &StressSample::err, p.stress, p.seed_scatter, p.within_err);
+    double scatter = 0, within = 0;
+    p.volume_err = combine(&StressSample::stress_volume, &StressSample::volume_err, p.stress_volume, scatter, within);
+    p.contact_err = combine(&StressSample::stress_contact, &StressSample::contact_err, p.stress_contact, scatter, within);
     out.push_back(p);
   }
   return out;

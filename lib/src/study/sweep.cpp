@@ -267,9 +267,10 @@ std::string sweep_csv(const std::vector<SweepPoint>& points, const std::string& 
                                   "stress_total_drift_z", "steady_mser_discard_fraction", "stress_particles", "stress_particles_err", "stress_fluid",
                                   "stress_virial", "stress_virial_err", "stress_virial_total", "stress_virial_total_err",
                                   "stress_virial_magnetic",
-                                  "stress_virial_contact", "n_particles", "n_fluid", "dt", "steps", "wall_seconds",
+                                  "stress_virial_contact", "stress_virial_contact_err", "n_particles", "n_fluid", "dt", "steps", "wall_seconds",
                                   "stokes_number", "reynolds_number", "max_overlap_over_radius", "volume_fraction",
-                                  "magnetization", "youngs_modulus", "viscosity", "fluid_density"};
+                                  "magnetization", "youngs_modulus", "viscosity", "fluid_density", "gap", "radius",
+                                  "spanning_fraction"};
   std::ostringstream csv;
   csv.precision(10);
   csv << "model,mason,seed,status";

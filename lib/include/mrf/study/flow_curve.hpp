@@ -22,9 +22,14 @@ struct StressSample {
   double stress = 0, err = 0;  // Pa, standard error within the run
   double stress_fluid = 0;     // Pa, the hydrodynamic part (eta gdot for model 1)
   double stress_volume = 0;    // Pa, volume-side total: pair virial + fluid (stress_virial_total)
+  double volume_err = 0;       // Pa, its standard error within the run
+  double stress_contact = 0;   // Pa, the contact part of the pair virial (stress_virial_contact)
+  double contact_err = 0;      // Pa, its standard error within the run
   double stokes = 0;           // Stokes number tau_p gdot of the run
   double reynolds = 0;         // particle Reynolds number rho_f gdot R^2 / eta of the run
   double magnetization = 0;    // A/m: the run's own (it varies with Mn on the path drive.vary = magnetization)
+  double volume_fraction = 0;  // 1
+  double gap_over_radius = 0;  // 1 (0 when sweep.csv has no gap and radius)
 };
 
 // Seed average at one Mason number.
@@ -36,9 +41,13 @@ struct FlowPoint {
   double within_err = 0;    // sqrt(sum err_i^2)/n (Pa)
   double stress_fluid = 0;  // mean hydrodynamic part (Pa)
   double stress_volume = 0; // mean volume-side total (Pa)
+  double volume_err = 0;    // its standard error, as err is the wall stress's
+  double stress_contact = 0;// mean contact part of the pair virial (Pa)
+  double contact_err = 0;   // its standard error, likewise
   double stokes = 0;        // Stokes number (the same for every seed)
   double reynolds = 0;      // particle Reynolds number (the same for every seed)
   double magnetization = 0; // A/m (the same for every seed)
+  double volume_fraction = 0, gap_over_radius = 0;  // likewise
   int seeds = 0;
 };
 

@@ -1,0 +1,119 @@
+#!/usr/bin/python3
+"""The report of the pre-registered held-out test of the model-1 criterion
+(issue 14; the rule and the analysis in docs/study.md, "The pre-registered
+criterion"). Written with the rule, before any run of the design, so that the
+analysis is fixed too; it reports what has finished and says what has not.
+
+usage: heldout.py SWEEP_DIR OUT_DIR
+
+SWEEP_DIR holds sweep.csv (mrf sweep experiments/sweeps/criterion_heldout.toml
+... --collect) and criterion.json (mrf criterion SWEEP_DIR). Writes
+OUT_DIR/heldout.md and OUT_DIR/heldout.png/.svg: the predicted shortfall
+against the truth, both levels marked.
+"""
+import json
+import math
+import os
+import sys
+from collections import defaultdict
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from study import num, read_rows, save  # noqa: E402
+
+DRIFT_Z, MSER_MAX = 3.0, 0.2
+GOAL = 0.9
+LEVELS = (("10", 0.1), ("20", 0.2))
+
+
+def fraction(x):
+    return "–" if x is None else "%.0f %%" % (100 * x)
+
+
+def matrix(c, title):
+    dec = c["right_adequate"] + c["right_not_adequate"] + c["wrong_adequate"] + c["wrong_not_adequate"]
+    return [
+        "| %s | model 1 within (truth) | model 1 off by more (truth) |" % title,
+        "|---|---:|---:|",
+        "| verdict adequate | %d right | **%d wrong (costly)** |" % (c["right_adequate"], c["wrong_adequate"]),
+        "| verdict not adequate | %d wrong (conservative) | %d right |" % (c["wrong_not_adequate"], c["right_not_adequate"]),
+        "",
+        "Decidable %d, undecidable %d (|D| within one standard error of the level); right %s of the decidable, "
+        "right %s of the \"adequate\" verdicts." % (dec, c["undecidable"], fraction(c["right_fraction"]),
+                                                  fraction(c["adequate_right_fraction"])),
+        "",
+    ]
+
+
+def main():
+    sweep_dir, out_dir = sys.argv[1], sys.argv[2]
+    crit = json.load(open(os.path.join(sweep_dir, "criterion.json")))["preregistered_criterion"]
+    rows = read_rows(os.path.join(sweep_dir, "sweep.csv"))
+    ok = [r for r in rows if r["status"] == "ok"]
+    unsteady = defaultdict(list)
+    for r in ok:
+        z, d = num(r, "stress_total_drift_z"), num(r, "steady_mser_discard_fraction")
+        if not (abs(z) < DRIFT_Z and d < MSER_MAX):
+            unsteady[(r["variant"], float(r["mason"]))].append("%s seed %s (z %+.1f, MSER %.2f)" % (
+                r["model"], r["seed"], z, d))
+    pts = crit["points"]
+    md = ["# Held-out test of the pre-registered model-1 criterion (issue 14)", "",
+          "Rule, derivation and analysis plan: docs/study.md, \"The pre-registered criterion\" (committed with "
+          "experiments/sweeps/criterion_heldout.toml before any of its runs). Design: reports/criterion/design.md. "
+          "Truth D = tau_1/tau_3 - 1 of the seed means (model 3 = demsph_dd); verdict from model 1's seed-mean "
+          "indicators: adequate at a when |delta| < a, delta = 1 - tau_wall/(tau_volume + (g(phi) - 1) "
+          "max(tau_contact, 0)).", "",
+          "Finished: %d of the design's runs ok, %d failed; %d (condition, Mn) pairs scored." % (
+              len(ok), sum(r["status"] == "failed" for r in rows), len(pts)), ""]
+    for tag, level in LEVELS:
+        c, m = crit["confusion_" + tag], crit["mismatch_only_confusion_" + tag]
+        md.append("## At %d %%" % round(100 * level))
+        md.append("")
+        md += matrix(c, "the rule")
+        goal = (c["right_fraction"] is not None and c["right_fraction"] >= GOAL and
+                c["adequate_right_fraction"] is not None and c["adequate_right_fraction"] >= GOAL)
+        md.append("Goal (>= 90 %% of decidable and of \"adequate\" verdicts right): **%s**." % (
+            "met" if goal else "not met"))
+        md.append("")
+        md += matrix(m, "|m| < a alone (the earlier rule without its Re clause)")
+    md += ["## Every scored point", "",
+           "| condition | phi | gap/R | Mn | St | D | delta | m | 10 % | 20 % | unsteady runs |",
+           "|---|---:|---:|---:|---:|---:|---:|---:|---|---|---|"]
+    short = {"right (adequate)": "right, adequate", "right (not adequate)": "right, not adequate"}
+    for p in pts:
+        v = p["curve"].split("@", 1)[1] if "@" in p["curve"] else ""
+        out = [short.get(p["outcome_" + t], p["outcome_" + t].split(":")[0]) for t, _ in LEVELS]
+        md.append("| %s | %.3f | %.0f | %g | %.1e | %+.3f ± %.3f | %.3f ± %.3f | %.3f | %s | %s | %s |" % (
+            v, p["volume_fraction"], p["gap_over_radius"], p["mason"], p["stokes"], p["deviation"],
+            p["deviation_err"], p["shortfall"], p["shortfall_err"], p["mismatch"], out[0], out[1],
+            "; ".join(unsteady.get((v, p["mason"]), [])) or "–"))
+    md.append("")
+    md.append("![shortfall against truth](heldout.png)")
+    fig, ax = plt.subplots(figsize=(5.5, 5))
+    for tag, level in LEVELS:
+        ax.axvline(level, color="0.6", lw=0.8, ls="--")
+        ax.axhline(level, color="0.6", lw=0.8, ls="--")
+    if pts:
+        x = [p["shortfall"] for p in pts]
+        y = [abs(p["deviation"]) for p in pts]
+        c = [p["volume_fraction"] for p in pts]
+        sc = ax.scatter(x, y, c=c, cmap="viridis", s=18)
+        ax.errorbar(x, y, yerr=[p["deviation_err"] for p in pts], xerr=[p["shortfall_err"] for p in pts], fmt="none",
+                    ecolor="0.5", lw=0.6)
+        fig.colorbar(sc, ax=ax, label="volume fraction")
+        top = max(max(x), max(y), 0.3) * 1.05
+        ax.plot([0, top], [0, top], color="k", lw=0.6)
+    ax.set_xlabel("predicted shortfall delta (one model-1 run)")
+    ax.set_ylabel("|tau_1/tau_3 - 1| (model 3 as truth)")
+    ax.set_title("held-out design: lower left = adequate")
+    os.makedirs(out_dir, exist_ok=True)
+    save(fig, out_dir, "heldout")
+    open(os.path.join(out_dir, "heldout.md"), "w").write("\n".join(md) + "\n")
+    print("-> %s" % os.path.join(out_dir, "heldout.md"))
+
+
+main()
