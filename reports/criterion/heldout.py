@@ -15,6 +15,7 @@ import json
 import math
 import os
 import sys
+import tomllib
 from collections import defaultdict
 
 import matplotlib
@@ -25,6 +26,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 from study import num, read_rows, save  # noqa: E402
 
+DESIGN = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "experiments", "sweeps",
+                      "criterion_heldout.toml")
 DRIFT_Z, MSER_MAX = 3.0, 0.2
 GOAL = 0.9
 LEVELS = (("10", 0.1), ("20", 0.2))
@@ -61,14 +64,18 @@ def main():
             unsteady[(r["variant"], float(r["mason"]))].append("%s seed %s (z %+.1f, MSER %.2f)" % (
                 r["model"], r["seed"], z, d))
     pts = crit["points"]
+    design = tomllib.load(open(DESIGN, "rb"))
+    n_pairs = len(design["variant"]) * len(design["sweep"]["mason"])
+    n_runs = n_pairs * len(design["sweep"]["models"]) * len(design["sweep"]["seeds"])
     md = ["# Held-out test of the pre-registered model-1 criterion (issue 14)", "",
           "Rule, derivation and analysis plan: docs/study.md, \"The pre-registered criterion\" (committed with "
           "experiments/sweeps/criterion_heldout.toml before any of its runs). Design: reports/criterion/design.md. "
           "Truth D = tau_1/tau_3 - 1 of the seed means (model 3 = demsph_dd); verdict from model 1's seed-mean "
           "indicators: adequate at a when |delta| < a, delta = 1 - tau_wall/(tau_volume + (g(phi) - 1) "
           "max(tau_contact, 0)).", "",
-          "Finished: %d of the design's runs ok, %d failed; %d (condition, Mn) pairs scored." % (
-              len(ok), sum(r["status"] == "failed" for r in rows), len(pts)), ""]
+          "Finished: %d of the design's %d runs ok, %d failed; %d of its %d (condition, Mn) pairs scored%s." % (
+              len(ok), n_runs, sum(r["status"] == "failed" for r in rows), len(pts), n_pairs,
+              "" if len(pts) == n_pairs else " (the test is still running: these counts are partial)"), ""]
     for tag, level in LEVELS:
         c, m = crit["confusion_" + tag], crit["mismatch_only_confusion_" + tag]
         md.append("## At %d %%" % round(100 * level))
