@@ -246,6 +246,18 @@ def main(argv):
                 cmp3 = f"{vol / w3 - 1:+.3f}"
             lines.append(f"| {k} | {m:g} | {len(rs)} | {wall:.4f} | {vol:.4f} | {1 - wall / vol:+.3f} | {cmp3} |")
     lines.append("")
+    pre = crit.get("preregistered_criterion", {}).get("points", [])
+    if pre:
+        lines += ["## The pre-registered model-1 criterion on this cell (training data)", "",
+                  "delta = 1 - wall/(volume side + (g(phi) - 1) max(contact virial, 0)) of model 1's seed means "
+                  "against the truth D = tau_1/tau_3 - 1 (docs/study.md, 'The pre-registered criterion'; "
+                  "these points were seen when the rule was written: its test is reports/criterion/heldout.md).", "",
+                  "| Mn | D | delta | m | verdict 10 % | verdict 20 % |", "|---:|---:|---:|---:|---|---|"]
+        for q in pre:
+            lines.append(f"| {q['mason']:g} | {q['deviation']:+.3f} ± {q['deviation_err']:.3f} | "
+                         f"{q['shortfall']:.3f} ± {q['shortfall_err']:.3f} | {q['mismatch']:.3f} | "
+                         f"{q['outcome_10']} | {q['outcome_20']} |")
+        lines.append("")
     if qs:
         lines += ["## The quasi-static limit (issue 17)", "",
                   "AQS wall stress of the paper cell (mrf quasistatic; reports/quasistatic/paper/), in φμ0M², beside "
