@@ -24,11 +24,11 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from paper_study import steady  # noqa: E402  (the drift and MSER tests of every point)
 from study import num, read_rows, save  # noqa: E402
 
 DESIGN = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "experiments", "sweeps",
                       "criterion_heldout.toml")
-DRIFT_Z, MSER_MAX = 3.0, 0.2
 GOAL = 0.9
 LEVELS = (("10", 0.1), ("20", 0.2))
 
@@ -59,8 +59,8 @@ def main():
     ok = [r for r in rows if r["status"] == "ok"]
     unsteady = defaultdict(list)
     for r in ok:
-        z, d = num(r, "stress_total_drift_z"), num(r, "steady_mser_discard_fraction")
-        if not (abs(z) < DRIFT_Z and d < MSER_MAX):
+        if not steady(r):
+            z, d = num(r, "stress_total_drift_z"), num(r, "steady_mser_discard_fraction")
             unsteady[(r["variant"], float(r["mason"]))].append("%s seed %s (z %+.1f, MSER %.2f)" % (
                 r["model"], r["seed"], z, d))
     pts = crit["points"]

@@ -144,6 +144,19 @@ TEST(QuasistaticSmallScene, UnconvergedMinimisationStopsTheRun) {
   }
 }
 
+// A plain load of a checkpoint written with other options is refused, naming the option.
+void expect_refused(const LoadedScene& scene, const QuasistaticOptions& o, const std::string& ckpt,
+                    const std::string& key) {
+  QuasistaticRun refused = quasistatic_run(scene, o);
+  try {
+    ArchiveReader in(ckpt);
+    refused.load(in);
+    FAIL() << "no error";
+  } catch (const NumericalError& err) {
+    EXPECT_NE(std::string(err.what()).find(key), std::string::npos) << err.what();
+  }
+}
+
 // A run checkpointed after two minima and restored into a fresh run of
 // the same scene continues bit for bit: the same minima, iterations and
 // stresses as the run that never stopped; a larger total strain extends a
@@ -200,14 +213,7 @@ TEST(QuasistaticResume, RestoredRunContinuesBitForBitAndExtends) {
 
   QuasistaticOptions other = o;
   other.strain_increment = 5e-4;
-  QuasistaticRun refused = quasistatic_run(scene, other);
-  try {
-    ArchiveReader in(ckpt);
-    refused.load(in);
-    FAIL() << "no error";
-  } catch (const NumericalError& err) {
-    EXPECT_NE(std::string(err.what()).find("quasistatic.strain_increment"), std::string::npos) << err.what();
-  }
+  expect_refused(scene, other, ckpt, "quasistatic.strain_increment");
 }
 
 // A branch (load with branch = true) takes another run's checkpoint at
@@ -253,14 +259,7 @@ TEST(QuasistaticResume, BranchAtAnotherToleranceStartsFromTheSameMinimum) {
   }
   QuasistaticOptions t = o;
   t.force_tol = 1e-6;
-  QuasistaticRun refused = quasistatic_run(scene, t);
-  try {
-    ArchiveReader in(ckpt);
-    refused.load(in);
-    FAIL() << "no error";
-  } catch (const NumericalError& err) {
-    EXPECT_NE(std::string(err.what()).find("quasistatic.force_tol"), std::string::npos) << err.what();
-  }
+  expect_refused(scene, t, ckpt, "quasistatic.force_tol");
 }
 
 TEST(QuasistaticOptions, BadValuesNameTheirKey) {
