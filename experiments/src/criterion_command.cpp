@@ -75,18 +75,19 @@ int run_directory(const std::string& dir, const Thresholds* t) {
                 "  delta = 1 - tau_wall/tau_ref = %.3f +- %.3f -> model 1 %s within 10 %%, %s within 20 %%\n"
                 "  tau_wall = %.4g +- %.2g Pa; tau_ref = tau_volume + (g - 1) max(tau_contact, 0) = %.4g +- %.2g Pa\n"
                 "  m = 1 - tau_wall/tau_volume = %.3f +- %.3f; tau_contact = %.4g +- %.2g Pa; g(phi = %.3g) = %.3f\n"
-                "  St = %.3g, Re_p = %.3g, Mn = %.3g, gap/R = %s, gap-spanning fraction = %s\n",
+                "  St = %.3g, Re_p = %.3g, Re_gap = %s, Mn = %.3g, gap/R = %s, gap-spanning fraction = %s\n",
                 dir.c_str(), sf.value, sf.err, mrf::shortfall_adequate(sf, 0.1) ? "ADEQUATE" : "NOT adequate",
                 mrf::shortfall_adequate(sf, 0.2) ? "ADEQUATE" : "NOT adequate", st.wall, st.wall_err, sf.reference,
                 sf.reference_err, sf.mismatch, sf.mismatch_err, st.contact, st.contact_err, st.volume_fraction,
-                sf.drag_ratio, rc.stokes, rc.reynolds, rc.mason,
+                sf.drag_ratio, rc.stokes, rc.reynolds,
+                rc.gap_over_radius > 0 ? std::to_string(mrf::gap_reynolds(rc)).c_str() : "unknown", rc.mason,
                 rc.gap_over_radius > 0 ? std::to_string(rc.gap_over_radius).c_str() : "unknown (no radius in summary.json)",
                 j.contains("spanning_fraction") ? std::to_string(num("spanning_fraction")).c_str() : "not measured");
     const mrf::CriterionDomain dom;
-    std::printf("  tested on (experiments/sweeps/criterion_heldout.toml): phi %.2g-%.2g, gap/R %.3g-%.3g, Mn %.2g-%.2g, "
-                "St <= %.2g, Re_p <= %.2g\n",
+    std::printf("  tested on (experiments/sweeps/criterion_heldout*.toml): phi %.2g-%.2g, gap/R %.3g-%.3g, Mn %.2g-%.2g, "
+                "St <= %.2g, Re_p <= %.2g, Re_gap = rho_f gdot gap^2/eta <= %.3g\n",
                 dom.phi_min, dom.phi_max, dom.gap_over_radius_min, dom.gap_over_radius_max, dom.mason_min,
-                dom.mason_max, dom.stokes_max, dom.reynolds_max);
+                dom.mason_max, dom.stokes_max, dom.reynolds_max, dom.gap_reynolds_max);
     for (const auto& w : mrf::outside_domain(rc, dom))
       std::printf("  OUTSIDE the tested range: %s (the verdict is an extrapolation)\n", w.c_str());
   }
@@ -124,6 +125,7 @@ ordered_json preregistered_json(const mrf::CriterionScore& sc) {
                    {"gap_over_radius", p.conditions.gap_over_radius},
                    {"stokes", p.conditions.stokes},
                    {"reynolds", p.conditions.reynolds},
+                   {"gap_reynolds", mrf::gap_reynolds(p.conditions)},
                    {"seeds", p.seeds}};
     if (!p.outside.empty()) r["outside_domain"] = p.outside;
     for (int k = 0; k < 2; ++k) {
@@ -153,6 +155,7 @@ ordered_json preregistered_json(const mrf::CriterionScore& sc) {
     const auto& m = sc.mismatch_only[k];
     out["confusion" + tag] = matrix(r);
     out["mismatch_only_confusion" + tag] = matrix(m);
+    out["in_domain_confusion" + tag] = matrix(sc.rule_in_domain[k]);
     if (!rows.empty())
       std::printf("pre-registered criterion at %2.0f %%: %d right (%d of them adequate), %d wrong 'adequate', %d wrong "
                   "'not adequate', %d undecidable; |m| alone: %d right, %d wrong 'adequate', %d wrong 'not adequate'\n",

@@ -1,9 +1,18 @@
 #!/usr/bin/python3
-"""The pre-registered held-out design of the model-1 criterion (issue 14).
+"""The pre-registered held-out designs of the model-1 criterion (issue 14).
 
-Writes experiments/sweeps/criterion_heldout.toml and prints the design table
-(reports/criterion/design.md). Deterministic: a fixed random seed, so running it
-again gives the same file; the design is committed before any of its runs.
+usage: design.py [1|2] [TOML]
+
+Design 1 (the default) writes experiments/sweeps/criterion_heldout.toml and
+prints its table (reports/criterion/design.md); design 2 writes
+experiments/sweeps/criterion_heldout2.toml (table reports/criterion/design2.md).
+Deterministic: a fixed random seed per design, so running it again gives the
+same file; each design is committed before any of its runs.
+
+Design 2 (fixed after design 1 had run, with the revised domain of
+docs/study.md, "The revised domain and its second test") draws over the same
+ranges with a new seed, 2 seeds per point, and one more constraint: the gap
+Reynolds number Re_gap = rho_f gdot gap^2 / eta <= 10 at the largest Mn.
 
 Each condition is one small shear cell scaled with the sphere diameter d (the
 small scene's ratios: lateral box 6.4 d x 6.4 d, dipole cut-off 3 d, wall
@@ -27,10 +36,12 @@ import sys
 
 import numpy as np
 
-SEED = 20261204
+DESIGNS = {
+    1: dict(seed=20261204, seeds=[1, 2, 3], re_gap_max=None, toml="experiments/sweeps/criterion_heldout.toml"),
+    2: dict(seed=20261205, seeds=[1, 2], re_gap_max=10.0, toml="experiments/sweeps/criterion_heldout2.toml"),
+}
 N_CONDITIONS = 24
 MASON = [0.03, 0.1, 0.3, 1.0, 3.0]
-SEEDS = [1, 2, 3]
 RADII_UM = [1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0]  # lengths stay short decimals
 RHO_P = 7800.0  # iron
 MU0 = 4e-7 * math.pi
@@ -52,12 +63,19 @@ def log_between(u, lo, hi):
     return lo * (hi / lo) ** u
 
 
-def draw(rng):
+def gap_reynolds(c, mason):
+    _, gdot = stokes(c["r_um"] * 1e-6, c["mag"], c["eta"], mason)
+    return c["rho_f"] * gdot * (c["gap_um"] * 1e-6) ** 2 / c["eta"]
+
+
+def draw(rng, re_gap_max):
     """Each variable from its own stratum of a Latin hypercube; the constrained
     ones mapped into what the earlier ones leave admissible, so that every
     condition is kept: gap within [10 d, 60 d] and [60, 300] um, and the
     viscosity (then the magnetisation's upper end) such that St <= ST_MAX at
-    the largest Mn: eta >= R M sqrt(c / ST_MAX), c = 4 rho_p mu0 max(Mn) / 81."""
+    the largest Mn: eta >= R M sqrt(c / ST_MAX), c = 4 rho_p mu0 max(Mn) / 81;
+    with re_gap_max also Re_gap <= re_gap_max there:
+    eta >= gap M sqrt(2 mu0 rho_f max(Mn) / (9 re_gap_max))."""
     u = lhs(rng, N_CONDITIONS, 6)
     c_st = 4 * RHO_P * MU0 * max(MASON) / 81
     out = []
@@ -72,16 +90,20 @@ def draw(rng):
         # the cell packs phi gap / (gap - 4 R) <= 0.35 (the spheres' centres keep R from the wall spheres)
         phi = 0.05 + (min(0.35, 0.35 * (gap_um - 4 * r_um) / gap_um) - 0.05) * a[0]
         phi = math.floor(phi * 1000) / 1000
+        rho_f = 700 + 600 * a[5]
         k = r_um * 1e-6 * math.sqrt(c_st / ST_MAX)  # eta_min = k M
+        if re_gap_max:
+            k = max(k, gap_um * 1e-6 * math.sqrt(2 * MU0 * round(rho_f) * max(MASON) / (9 * re_gap_max)) * 1.001)
         mag = log_between(a[3], 1e5, min(1e6, 0.5 / k))
         eta = log_between(a[4], max(0.02, k * mag), 0.5)
-        rho_f = 700 + 600 * a[5]
         out.append(dict(phi=phi, gap_um=round(gap_um, 3), r_um=r_um, eta=round(eta, 4),
                         rho_f=round(rho_f), mag=round(mag, -3)))
     return out
 
 
-def admissible(c):
+def admissible(c, re_gap_max):
+    if re_gap_max and gap_reynolds(c, max(MASON)) > re_gap_max * 1.02:
+        return False
     d = 2 * c["r_um"]
     st, _ = stokes(c["r_um"] * 1e-6, c["mag"], c["eta"], max(MASON))
     packs = c["phi"] * c["gap_um"] / (c["gap_um"] - 4 * c["r_um"]) <= 0.35
@@ -94,23 +116,29 @@ def spheres(c):
 
 
 def main():
-    rng = np.random.default_rng(SEED)
-    design = draw(rng)
-    bad = [c for c in design if not admissible(c)]
+    which = int(sys.argv[1]) if len(sys.argv) > 1 else 1
+    spec = DESIGNS[which]
+    rng = np.random.default_rng(spec["seed"])
+    design = draw(rng, spec["re_gap_max"])
+    bad = [c for c in design if not admissible(c, spec["re_gap_max"])]
     if bad:
         sys.exit("design.py: inadmissible conditions (a bug in draw): %s" % bad)
     design.sort(key=lambda c: (c["phi"], c["gap_um"]))
+    seeds = spec["seeds"]
+    report = "heldout.md" if which == 1 else "heldout2.md"
+    rule = ("the rule (docs/study.md, \"The pre-registered criterion\")" if which == 1 else
+            "the revised domain (docs/study.md, \"The revised domain and its second test\")")
     toml = [
-        "# Pre-registered held-out design of the model-1 criterion (issue 14), written",
-        "# by reports/criterion/design.py (random seed %d) and" % SEED,
-        "# committed with the rule (docs/study.md, \"The pre-registered criterion\")",
+        "# Pre-registered held-out design %sof the model-1 criterion (issue 14), written" % ("" if which == 1 else "2 "),
+        "# by reports/criterion/design.py%s (random seed %d) and" % ("" if which == 1 else " 2", spec["seed"]),
+        "# committed with %s" % rule,
         "# before any of its runs. Run it once; report it as it comes out",
-        "# (reports/criterion/heldout.md). Do not edit after its first run.",
+        "# (reports/criterion/%s). Do not edit after its first run." % report,
         "[sweep]",
         'scene = "../scenes/small_dem_stokes.toml"',
         'models = ["dem_stokes", "demsph_dd"]',
         "mason = [%s]" % ", ".join(repr(m) for m in MASON),
-        "seeds = [%s]" % ", ".join(str(s) for s in SEEDS),
+        "seeds = [%s]" % ", ".join(str(s) for s in seeds),
         'set = ["drive.vary=\'shear_rate\'", "numerics.threads=1", "drive.strain=20", "drive.warmup_strain=6",',
         '       "contact.youngs_modulus=\'200 GPa\'", "particles.density=\'7800 kg/m^3\'"]',
         "",
@@ -136,16 +164,16 @@ def main():
         st_lo, g_lo = stokes(r * 1e-6, c["mag"], c["eta"], min(MASON))
         st_hi, g_hi = stokes(r * 1e-6, c["mag"], c["eta"], max(MASON))
         re_hi = c["rho_f"] * g_hi * (r * 1e-6) ** 2 / c["eta"]
-        rows.append("| %s | %.3f | %g | %g | %.0f | %g | %.0f | %.0f | %.0f | %.2g-%.2g | %.1e | %.1e |" % (
+        extra = "" if which == 1 else " %.3g |" % gap_reynolds(c, max(MASON))
+        rows.append("| %s | %.3f | %g | %g | %.0f | %g | %.0f | %.0f | %.0f | %.2g-%.2g | %.1e | %.1e |%s" % (
             name, c["phi"], c["gap_um"], r, c["gap_um"] / r, c["eta"], c["rho_f"], c["mag"] / 1e3, spheres(c),
-            g_lo, g_hi, st_hi, re_hi))
-    open(sys.argv[1] if len(sys.argv) > 1 else "experiments/sweeps/criterion_heldout.toml", "w").write("\n".join(toml))
+            g_lo, g_hi, st_hi, re_hi, extra))
+    open(sys.argv[2] if len(sys.argv) > 2 else spec["toml"], "w").write("\n".join(toml))
     print("| condition | phi | gap (um) | R (um) | gap/R | eta (Pa s) | rho_f (kg/m^3) | M (kA/m) | spheres | "
-          "shear rate (1/s), Mn 0.03-3 | St at Mn 3 | Re_p at Mn 3 |")
-    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|")
+          "shear rate (1/s), Mn 0.03-3 | St at Mn 3 | Re_p at Mn 3 |" + ("" if which == 1 else " Re_gap at Mn 3 |"))
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|" + ("" if which == 1 else "---:|"))
     print("\n".join(rows))
     print("\n%d conditions x %d Mn x 2 models x %d seeds = %d runs" % (
-        len(design), len(MASON), len(SEEDS), len(design) * len(MASON) * 2 * len(SEEDS)))
-
+        len(design), len(MASON), len(seeds), len(design) * len(MASON) * 2 * len(seeds)))
 
 main()

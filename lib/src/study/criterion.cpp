@@ -180,6 +180,7 @@ std::vector<std::string> outside_domain(const RunConditions& c, const CriterionD
   };
   check("phi", c.volume_fraction, d.phi_min, d.phi_max);
   if (c.gap_over_radius > 0) check("gap/R", c.gap_over_radius, d.gap_over_radius_min, d.gap_over_radius_max);
+  if (c.gap_over_radius > 0) check("Re_gap", gap_reynolds(c), 0.0, d.gap_reynolds_max);
   check("Mn", c.mason, d.mason_min, d.mason_max);
   check("St", c.stokes, 0.0, d.stokes_max);
   check("Re_p", c.reynolds, 0.0, d.reynolds_max);
@@ -251,6 +252,7 @@ CriterionScore score_criterion(const std::map<std::string, std::vector<FlowPoint
         sp.mismatch_outcome[k] = score_verdict(std::abs(sp.shortfall.mismatch) < level, d.value, d.err, level);
         out.rule[k].add(sp.outcome[k]);
         out.mismatch_only[k].add(sp.mismatch_outcome[k]);
+        if (sp.outside.empty()) out.rule_in_domain[k].add(sp.outcome[k]);
       }
       out.points.push_back(sp);
     }
