@@ -123,8 +123,11 @@ def main():
             p["deviation_err"], p["shortfall"], p["shortfall_err"], p["mismatch"], out[0], out[1],
             "; ".join(unsteady.get((v, p["mason"]), [])) or "–"))
     md.append("")
-    md.append("![shortfall against truth](%s.png)" % name)
-    fig, ax = plt.subplots(figsize=(5.5, 5))
+    md.append("![shortfall against truth, and what it misses against the gap Reynolds number](%s.png)" % name)
+    md.append("")
+    md.append("Left: the rule's predicted shortfall against the truth (lower left: adequate at both levels). Right: "
+              "what the rule misses, |D| - delta, against Re_gap, the revised domain's bound dashed.")
+    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(11.5, 5), constrained_layout=True)
     for tag, level in LEVELS:
         ax.axvline(level, color="0.6", lw=0.8, ls="--")
         ax.axhline(level, color="0.6", lw=0.8, ls="--")
@@ -135,9 +138,19 @@ def main():
         sc = ax.scatter(x, y, c=c, cmap="viridis", s=18)
         ax.errorbar(x, y, yerr=[p["deviation_err"] for p in pts], xerr=[p["shortfall_err"] for p in pts], fmt="none",
                     ecolor="0.5", lw=0.6)
-        fig.colorbar(sc, ax=ax, label="volume fraction")
+        fig.colorbar(sc, ax=[ax, ax2], label="volume fraction")
         top = max(max(x), max(y), 0.3) * 1.05
         ax.plot([0, top], [0, top], color="k", lw=0.6)
+        rg = [p.get("gap_reynolds") or float("nan") for p in pts]
+        miss = [y[i] - x[i] for i in range(len(pts))]
+        ax2.errorbar(rg, miss, yerr=[math.hypot(p["deviation_err"], p["shortfall_err"]) for p in pts], fmt="none",
+                     ecolor="0.6", lw=0.6)
+        ax2.scatter(rg, miss, c=c, cmap="viridis", s=18)
+    ax2.set_xscale("log")
+    ax2.axvline(10, color="C3", lw=0.8, ls="--")
+    ax2.axhline(0, color="k", lw=0.6)
+    ax2.set_xlabel("Re_gap = rho_f gdot gap^2 / eta")
+    ax2.set_ylabel("|D| - delta (what the rule misses)")
     ax.set_xlabel("predicted shortfall delta (one model-1 run)")
     ax.set_ylabel("|tau_1/tau_3 - 1| (model 3 as truth)")
     ax.set_title("held-out design: lower left = adequate")
