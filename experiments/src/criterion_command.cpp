@@ -128,6 +128,12 @@ ordered_json preregistered_json(const mrf::CriterionScore& sc) {
                    {"gap_reynolds", mrf::gap_reynolds(p.conditions)},
                    {"seeds", p.seeds}};
     if (!p.outside.empty()) r["outside_domain"] = p.outside;
+    if (p.has_dd) {
+      r["one_way_dd_shortfall"] = p.dd.value;
+      r["one_way_dd_shortfall_err"] = p.dd.err;
+      for (int k = 0; k < 2; ++k)
+        r[std::string("one_way_dd_outcome") + (k == 0 ? "_10" : "_20")] = mrf::to_string(p.dd_outcome[k]);
+    }
     for (int k = 0; k < 2; ++k) {
       const std::string tag = k == 0 ? "_10" : "_20";
       r["adequate" + tag] = p.adequate[k];
@@ -156,6 +162,8 @@ ordered_json preregistered_json(const mrf::CriterionScore& sc) {
     out["confusion" + tag] = matrix(r);
     out["mismatch_only_confusion" + tag] = matrix(m);
     out["in_domain_confusion" + tag] = matrix(sc.rule_in_domain[k]);
+    if (sc.one_way_dd[k].decidable() + sc.one_way_dd[k].undecidable > 0)
+      out["one_way_dd_confusion" + tag] = matrix(sc.one_way_dd[k]);
     if (!rows.empty())
       std::printf("pre-registered criterion at %2.0f %%: %d right (%d of them adequate), %d wrong 'adequate', %d wrong "
                   "'not adequate', %d undecidable; |m| alone: %d right, %d wrong 'adequate', %d wrong 'not adequate'\n",

@@ -99,6 +99,9 @@ def main():
             "met" if goal else "not met"))
         md.append("")
         md += matrix(m, "|m| < a alone (the earlier rule without its Re clause)")
+        if "one_way_dd_confusion_" + tag in crit:
+            md += matrix(crit["one_way_dd_confusion_" + tag], "|delta_dd| < a (the one-way Di Felice estimate, "
+                         "model dem_dd's volume side)")
     if not second:
         md += ["## Post hoc: inside the revised domain (Re_gap <= 10)", "",
                "Not a test: the bound was set after these results (docs/study.md, \"The revised domain and its "
@@ -110,17 +113,18 @@ def main():
            "Re_gap = rho_f gdot gap^2 / eta of the carrier%s." % (
                "" if second else " (a post-hoc column, added after the first results came in, to look at the wrong "
                "verdicts; not part of the pre-registered rule or its scoring)"), "",
-           "| condition | phi | gap/R | Mn | St | Re_gap | D | delta | m | 10 % | 20 % | unsteady runs |",
-           "|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---|---|"]
+           "| condition | phi | gap/R | Mn | St | Re_gap | D | delta | m | delta_dd | 10 % | 20 % | unsteady runs |",
+           "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|---|"]
     short = {"right (adequate)": "right, adequate", "right (not adequate)": "right, not adequate"}
     for p in pts:
         v = p["curve"].split("@", 1)[1] if "@" in p["curve"] else ""
         out = [short.get(p["outcome_" + t], p["outcome_" + t].split(":")[0]) for t, _ in LEVELS]
         rg = p.get("gap_reynolds")
-        md.append("| %s | %.3f | %.0f | %g | %.1e | %s | %+.3f ± %.3f | %.3f ± %.3f | %.3f | %s | %s | %s |" % (
+        dd = "–" if "one_way_dd_shortfall" not in p else "%.3f" % p["one_way_dd_shortfall"]
+        md.append("| %s | %.3f | %.0f | %g | %.1e | %s | %+.3f ± %.3f | %.3f ± %.3f | %.3f | %s | %s | %s | %s |" % (
             v, p["volume_fraction"], p["gap_over_radius"], p["mason"], p["stokes"], "–" if rg is None else "%.3g" % rg,
             p["deviation"],
-            p["deviation_err"], p["shortfall"], p["shortfall_err"], p["mismatch"], out[0], out[1],
+            p["deviation_err"], p["shortfall"], p["shortfall_err"], p["mismatch"], dd, out[0], out[1],
             "; ".join(unsteady.get((v, p["mason"]), [])) or "–"))
     md.append("")
     md.append("![shortfall against truth, and what it misses against the gap Reynolds number](%s.png)" % name)

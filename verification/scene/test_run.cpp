@@ -32,6 +32,7 @@
 #include "mrf/io/toml_scene.hpp"
 #include "mrf/scene/build_model.hpp"
 #include "mrf/scene/dem_model.hpp"
+#include "mrf/scene/dem_params.hpp"
 #include "mrf/scene/run.hpp"
 #include "support/files.hpp"
 #include "support/small_scene.hpp"
@@ -227,6 +228,27 @@ TEST(RunOutput, StressPartsAddUpAndMasonFollowsTheDefinition) {
   EXPECT_DOUBLE_EQ(mason, 1e-2);
   // Both parts count: the particles carry a sizeable part of the stress at Mn = 0.01.
   EXPECT_GT(particles, 0.1 * fluid);
+}
+
+// Model dem_dd is model 1 with one change: the drag coefficient is Di
+// Felice's at Re -> 0 and the cell's mean porosity, 0.96 (1 - phi)^-2.7 times
+// Stokes'; the carrier (eta gdot), the Mason number and the shear rate stay.
+TEST(RunOutput, OneWayDiFeliceModelChangesOnlyTheDragCoefficient) {
+  const double phi = 0.30;  // the small scene's
+  const DemParams stokes = dem_params(scene().config), dd = dem_params(scene({"scene.model=dem_dd"}).config);
+  EXPECT_LE(rel(dd.gamma / stokes.gamma, 0.96 * std::pow(1 - phi, -2.7)), 1e-12);
+  EXPECT_LE(rel(stokes_number(stokes) / stokes_number(dd), dd.gamma / stokes.gamma), 1e-12);
+  EXPECT_EQ(dd.moment, stokes.moment);
+  EXPECT_EQ(dd.hertz_k, stokes.hertz_k);
+  const RunResult r = run({"scene.model=dem_dd"});
+  const nlohmann::json j = nlohmann::json::parse(r.json), j1 = nlohmann::json::parse(base_run().json);
+  EXPECT_EQ(j["model"], "dem_dd");
+  EXPECT_EQ(j["n_fluid"], 0);
+  EXPECT_EQ(j["shear_rate"], j1["shear_rate"]);
+  EXPECT_EQ(j["mason"], j1["mason"]);
+  EXPECT_LE(rel(j["stress_fluid"].get<double>(), k_eta * j["shear_rate"].get<double>()), 1e-15);
+  // the stronger drag changes the particles' stress: the run is not model 1 renamed
+  EXPECT_NE(j["stress_particles"].get<double>(), j1["stress_particles"].get<double>());
 }
 
 // ---- determinism ------------------------------------------------------------

@@ -121,6 +121,8 @@ TEST(PreregisteredCriterion, ScoresEachVariantAgainstItsOwnModel3) {
   const std::map<std::string, std::vector<FlowPoint>> curves{
       {"dem_stokes@a", {point(1, 90, 95, 2, 0.1)}},   // delta = 0.058: adequate
       {"demsph_dd@a", {point(1, 97, 97, 0, 0.1)}},    // D = -0.072: right at both levels
+      {"dem_dd@a", {point(1, 93, 96, 2, 0.1)}},       // delta_dd = 1 - 90/96 = 0.0625: adequate at both
+      {"dem_dd@b", {point(1, 61, 70, 2, 0.1)}},       // delta_dd = 1 - 60/70 = 0.143: adequate at 20 % only
       {"dem_stokes@b", {point(1, 60, 95, 2, 0.1)}},   // delta = 0.37: not adequate
       {"demsph_dd@b", {point(1, 64, 64, 0, 0.1)}},    // D = -0.0625: the conservative error at both
       {"dem_stokes@c", {point(1, 60, 95, 2, 0.1)}},   // no demsph_dd@c
@@ -131,6 +133,16 @@ TEST(PreregisteredCriterion, ScoresEachVariantAgainstItsOwnModel3) {
   const CriterionScore sc = score_criterion(curves);
   ASSERT_EQ(sc.points.size(), 3u);
   EXPECT_EQ(sc.points[2].outside, (std::vector<std::string>{"Re_gap = 25 > 10"}));
+  // the one-way Di Felice estimate: model 1's wall stress over dem_dd's volume side
+  ASSERT_TRUE(sc.points[0].has_dd && sc.points[1].has_dd);
+  EXPECT_FALSE(sc.points[2].has_dd);
+  EXPECT_NEAR(sc.points[0].dd.value, 1 - 90.0 / 96, 1e-15);
+  EXPECT_NEAR(sc.points[0].dd.err, 90.0 / 96 * std::hypot(1.0 / 90, 1.0 / 96), 1e-15);
+  EXPECT_NEAR(sc.points[1].dd.value, 1 - 60.0 / 70, 1e-15);
+  EXPECT_EQ(sc.one_way_dd[0].right_adequate, 1);
+  EXPECT_EQ(sc.one_way_dd[0].wrong_not_adequate, 1);  // D = -0.0625 at b
+  EXPECT_EQ(sc.one_way_dd[1].right_adequate, 2);
+  EXPECT_EQ(sc.one_way_dd[1].decidable(), 2);
   EXPECT_EQ(sc.rule[0].wrong_adequate, 1);
   EXPECT_EQ(sc.rule[1].right_adequate, 2);
   EXPECT_EQ(sc.points[0].curve, "dem_stokes@a");
@@ -170,7 +182,7 @@ TEST(PreregisteredCriterion, DomainEnclosesTheSecondHeldOutDesign) {
   const SweepSpec spec = load_sweep(MRF_SOURCE_DIR "/experiments/sweeps/criterion_heldout2.toml");
   EXPECT_GE(spec.variants.size(), 24u);
   EXPECT_GE(spec.seeds.size(), 2u);
-  EXPECT_EQ(spec.models, (std::vector<std::string>{"dem_stokes", "demsph_dd"}));
+  EXPECT_EQ(spec.models, (std::vector<std::string>{"dem_stokes", "demsph_dd", "dem_dd"}));
   double phi_lo = 1, phi_hi = 0, gr_lo = 1e9, gr_hi = 0, re_hi = 0;
   std::set<double> mason;
   for (const auto& [dir, rc] : design_conditions(spec)) {

@@ -110,7 +110,7 @@ const KeySpec k_keys[] = {
     {"output.frames", &C::frames, Dim::none, Need::optional, k_any},
 };
 
-constexpr ModelId k_models[] = {ModelId::dem_stokes, ModelId::demsph_stokes, ModelId::demsph_dd};
+constexpr ModelId k_models[] = {ModelId::dem_stokes, ModelId::demsph_stokes, ModelId::demsph_dd, ModelId::dem_dd};
 constexpr MasonBy k_vary[] = {MasonBy::shear_rate, MasonBy::magnetization};
 constexpr IntegratorId k_integrators[] = {IntegratorId::automatic, IntegratorId::verlet_exp,
                                           IntegratorId::overdamped, IntegratorId::implicit};
@@ -291,7 +291,7 @@ void read_values(LoadedScene& s, const Given& given) {
   }
 }
 
-bool is_sph(ModelId m) { return m != ModelId::dem_stokes; }
+bool is_sph(ModelId m) { return !is_one_way(m); }
 
 void require_keys(const LoadedScene& s, const Given& given) {
   for (const KeySpec& spec : k_keys) {

@@ -289,12 +289,12 @@ BuiltModel build_fluid_only(const LoadedScene& scene, bool quiet) {
 BuiltModel build_model(const LoadedScene& scene, bool quiet) {
   const SceneConfig& c = scene.config;
   use_scene_threads(c);
-  if (c.model != ModelId::dem_stokes && c.volume_fraction == 0) return build_fluid_only(scene, quiet);
+  if (!is_one_way(c.model) && c.volume_fraction == 0) return build_fluid_only(scene, quiet);
   const DemParams p = dem_params(c);
   ShearCell cell = build_shear_cell(c, scene.locate("particles.volume_fraction"));
   for (std::size_t i = 0; i < cell.free.size(); ++i) cell.free.v[i] = couette_velocity(cell.free.x[i], c.shear_rate);
-  BuiltModel b = c.model == ModelId::dem_stokes ? build_dem(scene, std::move(cell), p, quiet)
-                                                : build_coupled(scene, std::move(cell), p, quiet);
+  BuiltModel b = is_one_way(c.model) ? build_dem(scene, std::move(cell), p, quiet)
+                                     : build_coupled(scene, std::move(cell), p, quiet);
   b.summary.extra.insert({{"dipole_cutoff", c.dipole_cutoff}, {"gap", c.gap}, {"radius", c.radius}, {"box_ly", c.ly}, {"box_lz", c.lz}});
   return b;
 }

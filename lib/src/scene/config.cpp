@@ -18,6 +18,7 @@ const char* to_string(ModelId m) {
     case ModelId::dem_stokes: return "dem_stokes";
     case ModelId::demsph_stokes: return "demsph_stokes";
     case ModelId::demsph_dd: return "demsph_dd";
+    case ModelId::dem_dd: return "dem_dd";
   }
   return "?";
 }

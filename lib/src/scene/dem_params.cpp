@@ -1,5 +1,6 @@
 #include "mrf/scene/dem_params.hpp"
 
+#include "mrf/coupling/drag_laws.hpp"
 #include "mrf/forces/dipole.hpp"
 #include "mrf/forces/drag.hpp"
 #include "mrf/forces/hertz.hpp"
@@ -27,7 +28,10 @@ DemParams dem_params(const SceneConfig& c) {
   p.radius = c.radius;
   p.mass = c.density * sphere_volume(c.radius);
   p.moment = dipole_moment(c.radius, c.magnetization);
-  p.gamma = stokes_gamma(c.viscosity, c.radius);
+  // model dem_dd: the Di Felice coefficient at zero slip (Re -> 0) and the cell's mean porosity
+  p.gamma = c.model == ModelId::dem_dd
+                ? di_felice_drag_coefficient(0.0, 1.0 - c.volume_fraction, 2.0 * c.radius, c.fluid_density, c.viscosity)
+                : stokes_gamma(c.viscosity, c.radius);
   p.tau_p = relaxation_time(p.mass, p.gamma);
   p.hertz_k = hertz_stiffness(c.youngs_modulus, c.poisson_ratio, c.radius, c.radius);
   p.dipole_pref = dipole_prefactor(p.moment);

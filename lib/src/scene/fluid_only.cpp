@@ -15,7 +15,7 @@ namespace mrf {
 namespace {
 
 void validate_scene(const SceneConfig& cfg, double t_end) {
-  if (cfg.model == ModelId::dem_stokes)
+  if (is_one_way(cfg.model))
     throw InputError("scene.model", to_string(cfg.model), "", "the SPH Couette run needs an SPH model (demsph_*)");
   if (cfg.volume_fraction != 0.0) {
     std::ostringstream s;

@@ -169,6 +169,11 @@ Shortfall predicted_shortfall(const Model1Stresses& s) {
   return r;
 }
 
+OneWayDdShortfall one_way_dd_shortfall(double wall1, double wall1_err, double volume_dd, double volume_dd_err) {
+  const double r = wall1 / volume_dd;
+  return {1.0 - r, std::abs(r) * std::hypot(wall1_err / wall1, volume_dd_err / volume_dd)};
+}
+
 std::vector<std::string> outside_domain(const RunConditions& c, const CriterionDomain& d) {
   std::vector<std::string> out;
   const auto check = [&out](const char* name, double v, double lo, double hi) {
@@ -232,6 +237,7 @@ CriterionScore score_criterion(const std::map<std::string, std::vector<FlowPoint
     if (key.rfind(model1, 0) != 0) continue;
     const auto ref = curves.find("demsph_dd" + key.substr(model1.size()));
     if (ref == curves.end()) continue;
+    const auto dd = curves.find("dem_dd" + key.substr(model1.size()));
     for (const Deviation& d : deviation(pts, ref->second)) {
       const FlowPoint& p = *std::find_if(pts.begin(), pts.end(), [&](const FlowPoint& x) { return x.mason == d.mason; });
       if (p.stress_volume == 0) continue;
@@ -245,6 +251,14 @@ CriterionScore score_criterion(const std::map<std::string, std::vector<FlowPoint
       sp.conditions = {p.volume_fraction, p.gap_over_radius, p.mason, p.stokes, p.reynolds};
       sp.seeds = p.seeds;
       sp.outside = outside_domain(sp.conditions);
+      if (dd != curves.end()) {
+        const auto q = std::find_if(dd->second.begin(), dd->second.end(),
+                                    [&](const FlowPoint& x) { return x.mason == d.mason && x.stress_volume != 0; });
+        if (q != dd->second.end()) {
+          sp.has_dd = true;
+          sp.dd = one_way_dd_shortfall(p.stress, p.err, q->stress_volume, q->volume_err);
+        }
+      }
       for (int k = 0; k < 2; ++k) {
         const double level = k_criterion_levels[k];
         sp.adequate[k] = shortfall_adequate(sp.shortfall, level);
@@ -253,6 +267,10 @@ CriterionScore score_criterion(const std::map<std::string, std::vector<FlowPoint
         out.rule[k].add(sp.outcome[k]);
         out.mismatch_only[k].add(sp.mismatch_outcome[k]);
         if (sp.outside.empty()) out.rule_in_domain[k].add(sp.outcome[k]);
+        if (sp.has_dd) {
+          sp.dd_outcome[k] = score_verdict(std::abs(sp.dd.value) < level, d.value, d.err, level);
+          out.one_way_dd[k].add(sp.dd_outcome[k]);
+        }
       }
       out.points.push_back(sp);
     }

@@ -31,7 +31,7 @@ double estimate_seconds(const LoadedScene& scene, double cost_rate) {
   const TimeStepChoice ts = choose_time_step(scene, p);
   const double n_wall = c.wall_spacing > 0 ? 2.0 * (c.ly / c.wall_spacing) * (c.lz / c.wall_spacing) : 0.0;
   double particles = n_free + n_wall;
-  if (c.model != ModelId::dem_stokes && c.sph_spacing > 0)
+  if (!is_one_way(c.model) && c.sph_spacing > 0)
     particles += volume / (c.sph_spacing * c.sph_spacing * c.sph_spacing);
   const double steps = c.strain / (c.shear_rate * ts.dt);
   return steps * particles / cost_rate;
@@ -44,7 +44,7 @@ double estimate_seconds(const LoadedScene& scene, double cost_rate) {
 // the key with its location and the value.
 void validate_point_fluid(const SweepPoint& p, const LoadedScene& scene) {
   const SceneConfig& c = scene.config;
-  if (c.model == ModelId::dem_stokes) return;  // no fluid
+  if (is_one_way(c.model)) return;  // no fluid
   try {
     fluid_params_from_scene(c).validate(Box{c.gap, c.ly, c.lz});
   } catch (const InputError& e) {

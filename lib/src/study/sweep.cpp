@@ -53,10 +53,11 @@ void check_models(const std::vector<std::string>& models, const toml::node& n, c
                   const std::string& source) {
   for (const auto& m : models) {
     bool known = false;
-    for (ModelId id : {ModelId::dem_stokes, ModelId::demsph_stokes, ModelId::demsph_dd}) known |= m == to_string(id);
+    for (ModelId id : {ModelId::dem_stokes, ModelId::demsph_stokes, ModelId::demsph_dd, ModelId::dem_dd})
+      known |= m == to_string(id);
     if (!known)
       throw InputError(key, "\"" + m + "\"", where_of(n, source),
-                       "unknown model; expected dem_stokes, demsph_stokes or demsph_dd");
+                       "unknown model; expected dem_stokes, demsph_stokes, demsph_dd or dem_dd");
   }
 }
 

@@ -10,7 +10,14 @@
 
 namespace mrf {
 
-enum class ModelId { dem_stokes, demsph_stokes, demsph_dd };
+// dem_dd is not one of the study's three models: it is model 1 (one-way, an
+// imposed Couette carrier) with the Di Felice drag at Re -> 0 and the cell's
+// mean porosity 1 - phi in place of Stokes', a probe of how much of model 3's
+// stress its porosity-dependent drag alone explains (the second, cheaper
+// estimate of the criterion, issue 14: docs/study.md).
+enum class ModelId { dem_stokes, demsph_stokes, demsph_dd, dem_dd };
+// The one-way models: particles in an imposed carrier, no SPH.
+inline bool is_one_way(ModelId m) { return m == ModelId::dem_stokes || m == ModelId::dem_dd; }
 // What sets the Mason number (REFERENCE §8, "How the Mason number is
 // varied"): the shear rate at the given magnetisation, or the magnetisation
 // at the given shear rate, M = sqrt(9 eta gdot / (2 mu0 Mn)).

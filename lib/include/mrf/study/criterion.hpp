@@ -105,6 +105,17 @@ struct Shortfall {
   double value = 0, err = 0;                // delta = 1 - tau_wall / tau_ref (errors combined as independent)
 };
 Shortfall predicted_shortfall(const Model1Stresses& s);
+
+// The second estimate (fixed with design 2, docs/study.md "The one-way
+// Di Felice estimate"): a model dem_dd run of the same scene (model 1 with
+// the Di Felice drag at Re -> 0 and the mean porosity, one more model-1-cost
+// run) gives model 3's wall stress by its volume side, without the bound of
+// the drag term: delta_dd = 1 - tau_wall,1 / tau_volume,dd. Errors combined
+// as independent.
+struct OneWayDdShortfall {
+  double value = 0, err = 0;
+};
+OneWayDdShortfall one_way_dd_shortfall(double wall1, double wall1_err, double volume_dd, double volume_dd_err);
 inline bool shortfall_adequate(const Shortfall& s, double level) { return std::abs(s.value) < level; }
 
 // The conditions the held-out designs span (experiments/sweeps/criterion_heldout.toml
@@ -164,14 +175,19 @@ struct ScoredPoint {
   bool adequate[2] = {false, false};
   Outcome outcome[2] = {Outcome::undecidable, Outcome::undecidable};
   Outcome mismatch_outcome[2] = {Outcome::undecidable, Outcome::undecidable};
+  bool has_dd = false;  // a dem_dd curve with this Mn and its volume side
+  OneWayDdShortfall dd;
+  Outcome dd_outcome[2] = {Outcome::undecidable, Outcome::undecidable};
 };
 struct CriterionScore {
   std::vector<ScoredPoint> points;
   Confusion rule[2], mismatch_only[2];  // at k_criterion_levels, every point
   Confusion rule_in_domain[2];          // the points inside CriterionDomain only
+  Confusion one_way_dd[2];              // |delta_dd| < a, on the points that have a dem_dd run
 };
 // Flow curves keyed as SweepTable::samples after seed_average; points of model
-// 1 without a volume-side stress (an older sweep.csv) are left out.
+// 1 without a volume-side stress (an older sweep.csv) are left out. Where a
+// dem_dd[@variant] curve has the point too, delta_dd is scored beside.
 CriterionScore score_criterion(const std::map<std::string, std::vector<FlowPoint>>& curves);
 
 // tau_m/tau_ref - 1 at the Mason numbers both flow curves have.
