@@ -105,6 +105,7 @@ struct Shortfall {
   double value = 0, err = 0;                // delta = 1 - tau_wall / tau_ref (errors combined as independent)
 };
 Shortfall predicted_shortfall(const Model1Stresses& s);
+inline bool shortfall_adequate(const Shortfall& s, double level) { return std::abs(s.value) < level; }
 
 // The second estimate (fixed with design 2, docs/study.md "The one-way
 // Di Felice estimate"): a model dem_dd run of the same scene (model 1 with
@@ -116,7 +117,6 @@ struct OneWayDdShortfall {
   double value = 0, err = 0;
 };
 OneWayDdShortfall one_way_dd_shortfall(double wall1, double wall1_err, double volume_dd, double volume_dd_err);
-inline bool shortfall_adequate(const Shortfall& s, double level) { return std::abs(s.value) < level; }
 
 // The conditions the held-out designs span (experiments/sweeps/criterion_heldout.toml
 // and criterion_heldout2.toml): outside them the verdict is an extrapolation.
