@@ -61,6 +61,31 @@ TEST(SweepVariants, GridIsModelVariantMasonSeedWithTheVariantAfterTheRules) {
   EXPECT_TRUE(plain[0].variant.empty());
 }
 
+TEST(SweepRules, SeedsSelectThePointsARuleLengthens) {
+  // a rule for seed 2 alone (a re-run of a point that failed a steadiness
+  // test): the other seed keeps its overrides, so its scene and archive
+  // entry are unchanged
+  const std::string t = text("mason = [0.01]\n", "[[rule]]\nmodels = [\"demsph_dd\"]\nseeds = [2]\n"
+                                                  "set = [\"drive.strain=8\"]\n");
+  const auto pts = sweep_points(parse_sweep(t, "v.toml", k_scenes));
+  ASSERT_EQ(pts.size(), 4u);
+  const std::vector<std::string> plain{"drive.strain=4", "scene.model=\"demsph_dd\"", "drive.mason=0.01", "scene.seed=1"};
+  const std::vector<std::string> longer{"drive.strain=4", "drive.strain=8", "scene.model=\"demsph_dd\"",
+                                        "drive.mason=0.01", "scene.seed=2"};
+  EXPECT_EQ(pts[2].sets, plain);
+  EXPECT_EQ(pts[3].sets, longer);
+  EXPECT_EQ(pts[1].sets.size(), 4u);  // dem_stokes seed 2: not the rule's model
+  for (const std::string bad : {"seeds = [-1]\n", "seeds = [\"2\"]\n", "seeds = 2\n"}) {
+    try {
+      parse_sweep(text("mason = [0.01]\n", "[[rule]]\n" + bad + "set = [\"drive.strain=8\"]\n"), "v.toml", k_scenes);
+      FAIL() << "expected InputError for " << bad;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.key(), "rule.seeds") << e.what();
+      EXPECT_NE(std::string(e.what()).find("v.toml:11"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(SweepVariants, SweepMasonMayBeLeftOutOnlyWhenEveryVariantHasItsOwn) {
   const std::string own = "[[variant]]\nname = \"a\"\nmason = [0.1]\n[[variant]]\nname = \"b\"\nmason = [0.2, 0.3]\n";
   EXPECT_EQ(sweep_points(parse_sweep(text("", own), "v.toml", k_scenes)).size(), 2u * 3u * 2u);

@@ -49,6 +49,16 @@ std::vector<std::string> strings(const toml::array& a, const std::string& key, c
   return out;
 }
 
+std::vector<std::uint64_t> seeds(const toml::array& a, const std::string& key, const std::string& source) {
+  std::vector<std::uint64_t> out;
+  for (const auto& e : a) {
+    const auto v = e.value<std::int64_t>();
+    if (!v || *v < 0) throw InputError(key, text_of(e), where_of(e, source), "expected a non-negative integer");
+    out.push_back(static_cast<std::uint64_t>(*v));
+  }
+  return out;
+}
+
 void check_models(const std::vector<std::string>& models, const toml::node& n, const std::string& key,
                   const std::string& source) {
   for (const auto& m : models) {
@@ -154,11 +164,7 @@ SweepSpec parse_sweep(const std::string& toml_text, const std::string& source, c
   check_models(s.models, models, "sweep.models", source);
   if (sw->get("mason") || !root.get("variant"))
     for (const auto& e : need_array(*sw, "mason", "sweep", source)) s.mason.push_back(positive_number(e, "sweep.mason", source));
-  for (const auto& e : need_array(*sw, "seeds", "sweep", source)) {
-    const auto v = e.value<std::int64_t>();
-    if (!v || *v < 0) throw InputError("sweep.seeds", text_of(e), where_of(e, source), "expected a non-negative integer");
-    s.seeds.push_back(static_cast<std::uint64_t>(*v));
-  }
+  s.seeds = seeds(need_array(*sw, "seeds", "sweep", source), "sweep.seeds", source);
   if (const auto* set = (*sw)["set"].as_array()) s.set = strings(*set, "sweep.set", source);
   if (const toml::node* rules = root.get("rule")) {
     const auto* arr = rules->as_array();
@@ -176,6 +182,10 @@ SweepSpec parse_sweep(const std::string& toml_text, const std::string& source, c
           if (!a) throw InputError("rule.models", text_of(v), where_of(v, source), "expected an array of model names");
           r.models = strings(*a, "rule.models", source);
           check_models(r.models, v, "rule.models", source);
+        } else if (key == "seeds") {
+          const auto* a = v.as_array();
+          if (!a) throw InputError("rule.seeds", text_of(v), where_of(v, source), "expected an array of seeds");
+          r.seeds = seeds(*a, "rule.seeds", source);
         } else if (key == "set") {
           const auto* a = v.as_array();
           if (!a) throw InputError("rule.set", text_of(v), where_of(v, source), "expected an array of section.key=value");
@@ -220,7 +230,8 @@ std::vector<SweepPoint> sweep_points(const SweepSpec& spec) {
             const bool model_ok =
                 r.models.empty() || std::find(r.models.begin(), r.models.end(), model) != r.models.end();
             const bool mn_ok = (r.mason_min == 0 || mn >= r.mason_min) && (r.mason_max == 0 || mn <= r.mason_max);
-            if (model_ok && mn_ok) p.sets.insert(p.sets.end(), r.set.begin(), r.set.end());
+            const bool seed_ok = r.seeds.empty() || std::find(r.seeds.begin(), r.seeds.end(), seed) != r.seeds.end();
+            if (model_ok && mn_ok && seed_ok) p.sets.insert(p.sets.end(), r.set.begin(), r.set.end());
           }
           p.sets.insert(p.sets.end(), v.set.begin(), v.set.end());
           p.sets.push_back("scene.model=\"" + model + "\"");

@@ -38,6 +38,7 @@ namespace mrf {
 struct SweepRule {
   double mason_min = 0, mason_max = 0;  // 0 = no bound
   std::vector<std::string> models;      // empty = all
+  std::vector<std::uint64_t> seeds;     // empty = all (a longer run for the seeds that failed a steadiness test)
   std::vector<std::string> set;
 };
 
