@@ -11,6 +11,7 @@ usage: paper_study.py SWEEP_DIR OUT_DIR [--small reports/study/flow_curves.csv]
                       [--fixed-m reports/study/paper/fixed_m_sweep.csv]
                       [--fixed-m-criterion reports/study/paper/fixed_m_criterion.json]
                       [--aqs-seeds headline_0.45,seed2,seed3]
+                      [--first-runs reports/study/paper/first_runs] [--note TEXT]
 
 The fixed-M path (experiments/sweeps/paper_fixed_m.toml, collected with
 `mrf sweep ... --archive reports/study/paper/fixed_m_points --collect`, then
@@ -24,6 +25,10 @@ row per AQS run), is drawn at the left edge of both panels and tabulated
 beside the lowest-Mn particle stresses; the star is the value to quote, the
 mean of the seed realisations named by --aqs-seeds (over their common
 window) with the standard error of their scatter.
+
+--first-runs: the summaries of the first runs of points re-run for
+steadiness, listed under the steadiness table with what their re-runs gave.
+--note: a paragraph under the title (what state the report is in).
 
 SWEEP_DIR holds sweep.csv (mrf sweep ... --collect) and criterion.json
 (mrf criterion SWEEP_DIR). Writes OUT_DIR/paper.md and its figures.
@@ -173,8 +178,10 @@ def main(argv):
              f"Paper cell (150 x 50 x 120 um, {int(num(rows[0], 'n_particles')) if rows else 0} spheres, dipole "
              f"cut-off 4 d, Y = 200 GPa) on the realistic path: gdot = {gdot:g} 1/s for every point, "
              "M = sqrt(9 eta gdot / (2 mu0 Mn)) (REFERENCE.md §8). Sweep: experiments/sweeps/paper_realistic.toml; "
-             "finished points are archived in reports/study/paper/points/ (mrf sweep --archive).", "",
-             "![stress](stress_vs_mason.png)", ""]
+             "finished points are archived in reports/study/paper/points/ (mrf sweep --archive).", ""]
+    if "--note" in argv:
+        lines += [arg(argv, "--note", ""), ""]
+    lines += ["![stress](stress_vs_mason.png)", ""]
     grid = [1e-3, 1e-2, 0.1, 1.0, 10.0]
     done = defaultdict(int)
     for r in rows:
@@ -216,6 +223,33 @@ def main(argv):
                      f"({num(r, 'warmup_strain'):g}) | {num(r, 'stress_total_drift_z'):+.2f} | "
                      f"{num(r, 'steady_mser_discard_fraction'):.3f} | {'yes' if steady(r) else '**no**'} | "
                      f"{per:.3g} |")
+    # The first runs of points re-run for steadiness (their summaries kept
+    # in first_runs/ before the re-run overwrote the archive entry).
+    first_dir = arg(argv, "--first-runs", os.path.join(here, "study", "paper", "first_runs"))
+    firsts = []
+    for dirpath, _, files in sorted(os.walk(first_dir)) if os.path.isdir(first_dir) else []:
+        if "summary.json" in files:
+            firsts.append(json.load(open(os.path.join(dirpath, "summary.json"))))
+    current = {(r["model"], float(r["mason"]), int(r["seed"])): r for r in rows}
+    if firsts:
+        lines += ["", "First runs of the points re-run with strain and warm-up doubled (the policy: the re-run "
+                  "rules of experiments/sweeps/paper_realistic.toml); 'in the table above' when the first run is "
+                  "what the tables use (its re-run has not finished).", "",
+                  "| model | Mn | seed | strain (warm-up) | drift z | MSER discard | steady | re-run |",
+                  "|---|---:|---:|---:|---:|---:|---|---|"]
+        for f in sorted(firsts, key=lambda f: (ORDER.index(f["model"]), f["mason"], f["seed"])):
+            now = current.get((f["model"], float(f["mason"]), int(f["seed"])))
+            if now is None:
+                state = "pending; not in the tables"
+            elif num(now, "strain") == f["strain"]:
+                state = "pending; in the table above"
+            else:
+                state = (f"{num(now, 'strain'):g} ({num(now, 'warmup_strain'):g}): z {num(now, 'stress_total_drift_z'):+.2f}, "
+                         f"MSER {num(now, 'steady_mser_discard_fraction'):.3f}, {'steady' if steady(now) else '**not steady**'}")
+            ok = abs(f["stress_total_drift_z"]) < DRIFT_Z and f["steady_mser_discard_fraction"] < MSER_MAX
+            lines.append(f"| {f['model']} | {f['mason']:g} | {f['seed']} | {f['strain']:g} ({f['warmup_strain']:g}) | "
+                         f"{f['stress_total_drift_z']:+.2f} | {f['steady_mser_discard_fraction']:.3f} | "
+                         f"{'yes' if ok else '**no**'} | {state} |")
     lines += ["", "Cost: wall seconds per strain unit of each run, one thread, on a shared 2-core machine "
               "(the sweep ran at nice 19 beside other work: an upper bound, not a benchmark; "
               "reports/performance/model_ratios.md has the side-by-side ratios).", ""]
