@@ -2,7 +2,8 @@
 //   mrf run SCENE.toml [--set section.key=value]... [--out DIR] [--quiet] [--resume] [--checkpoint-every S]
 //   mrf criterion SWEEP_DIR|RUN_DIR [--thresholds FILE]
 //   mrf quasistatic SCENE.toml [--set k=v]... [--out DIR] [--increment D] [--tol T] [--strain S] [--warmup W]
-//             [--cutoff R] [--no-affine] [--resume] [--branch-from CHECKPOINT] [--checkpoint-every S]
+//             [--cutoff R] [--no-affine] [--minimiser fire|lbfgs] [--lbfgs-memory M] [--resume]
+//             [--branch-from CHECKPOINT] [--checkpoint-every S]
 //   mrf sweep SWEEP.toml [--out DIR] [--quiet] [--estimate | --list | --collect] [--point K | --rank R --ranks K]
 //             [--checkpoint-every S] [--archive DIR]   (mpirun -n K: master-worker schedule)
 // Exit status: 0 done, 2 bad input, 3 numerical failure or refused
@@ -216,12 +217,17 @@ int main(int argc, char** argv) {
   qs->add_option("--strain", qs_strain, "total strain (default the scene's drive.strain)");
   qs->add_option("--warmup", qs_warmup, "strain left out of the steady mean (default drive.warmup_strain)");
   qs->add_option("--cutoff", qo.dipole_cutoff, "shifted-force dipole cut-off in m (default particles.dipole_cutoff)");
-  qs->add_option("--max-iterations", qo.max_iterations, "FIRE iterations per minimisation")->capture_default_str();
+  std::string qs_minimiser = "fire";
+  qs->add_option("--minimiser", qs_minimiser, "energy minimiser: fire (FIRE 2.0) or lbfgs (L-BFGS)")
+      ->capture_default_str();
+  qs->add_option("--lbfgs-memory", qo.lbfgs_memory, "L-BFGS correction pairs")->capture_default_str();
+  qs->add_option("--max-iterations", qo.max_iterations, "force evaluations per minimisation after the first")
+      ->capture_default_str();
   qs->add_flag("--no-affine", no_affine, "free particles not displaced affinely before each minimisation");
   qs->add_flag("--quiet", qs_cli.quiet, "no progress on stderr");
   qs->add_option("--branch-from", qs_cli.branch_from,
-                 "start from another run's checkpoint.bin (same scene and settings but --tol): a pathwise "
-                 "tolerance test from one minimum");
+                 "start from another run's checkpoint.bin (same scene and settings but --tol and --minimiser): a "
+                 "pathwise test of either from one minimum");
   qs->add_flag("--resume", qs_cli.resume,
                "continue from OUT/checkpoint.bin (same scene and options; a larger --strain extends a finished run)");
   qs->add_option("--checkpoint-every", qs_cli.checkpoint_seconds,
@@ -235,6 +241,7 @@ int main(int argc, char** argv) {
     if (*sw) return sweep_command(sa);
     if (*qs) {
       qo.affine = !no_affine;
+      qo.minimiser = mrf::parse_minimiser(qs_minimiser, "--minimiser");
       if (qs_strain > 0) qo.strain = qs_strain;
       if (qs_warmup >= 0) qo.warmup_strain = qs_warmup;
       return quasistatic_command(qs_scene, qs_sets, qs_out, qo, qs_cli);

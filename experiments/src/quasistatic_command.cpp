@@ -10,10 +10,10 @@
 // written; --resume continues from the checkpoint, bit for bit, and with a
 // larger --strain extends a finished run. The checkpoint names its scene
 // (scene_id) and options; another scene or increment, tolerance, affine
-// start or cut-off is refused. --branch-from CHECKPOINT starts a new run
-// (a new --out) from another run's checkpoint at another --tol, everything
-// else the same: both tolerances then go on from one minimum, a pathwise
-// comparison; OUT/branch.json and summary.json's branched_from say where.
+// start, cut-off or minimiser is refused. --branch-from CHECKPOINT starts a
+// new run (a new --out) from another run's checkpoint at another --tol or
+// --minimiser, everything else the same: both then go on from one minimum,
+// a pathwise comparison; OUT/branch.json and summary.json's branched_from say where.
 #include "quasistatic_command.hpp"
 
 #include <cstdio>
@@ -102,8 +102,9 @@ int quasistatic_command(const std::string& scene_path, const std::vector<std::st
     throw mrf::InputError("--out", out, "", "holds a checkpoint of an earlier run: --resume continues it, or choose another --out");
   }
   if (!cli.quiet)
-    std::fprintf(stderr, "mrf quasistatic: %s, increments of %g to strain %g, max |f| < %g F0, affine %s\n",
-                 scene_path.c_str(), opt.strain_increment, *opt.strain, opt.force_tol, opt.affine ? "on" : "off");
+    std::fprintf(stderr, "mrf quasistatic: %s, increments of %g to strain %g, max |f| < %g F0, affine %s, %s\n",
+                 scene_path.c_str(), opt.strain_increment, *opt.strain, opt.force_tol, opt.affine ? "on" : "off",
+                 mrf::minimiser_name(opt.minimiser));
   const std::size_t first = run.next_increment();
   const double t_first = run.wall_seconds();
   double t_saved = t_first;
@@ -112,7 +113,7 @@ int quasistatic_command(const std::string& scene_path, const std::vector<std::st
     const double t = run.wall_seconds();
     if (!cli.quiet) {
       const double per = (t - t_first) / static_cast<double>(run.next_increment() - first);
-      std::fprintf(stderr, "\r  strain %.4f / %g  wall %.4g Pa  virial %.4g Pa  %ld FIRE iterations  %.0f s, about %.0f s left   ",
+      std::fprintf(stderr, "\r  strain %.4f / %g  wall %.4g Pa  virial %.4g Pa  %ld iterations  %.0f s, about %.0f s left   ",
                    p.strain, *opt.strain, p.stress_wall, p.stress_virial, p.iterations, t,
                    per * static_cast<double>(run.increments() + 1 - run.next_increment()));
     }
@@ -125,7 +126,9 @@ int quasistatic_command(const std::string& scene_path, const std::vector<std::st
   write_checkpoint(run, id, out);  // kept: --resume with a larger --strain extends the run
   const mrf::QuasistaticResult r = run.finish();
   nlohmann::ordered_json j;
-  j["driver"] = "quasistatic (AQS, FIRE 2.0)";
+  j["driver"] = opt.minimiser == mrf::Minimiser::lbfgs ? "quasistatic (AQS, L-BFGS)" : "quasistatic (AQS, FIRE 2.0)";
+  j["minimiser"] = mrf::minimiser_name(opt.minimiser);
+  if (opt.minimiser == mrf::Minimiser::lbfgs) j["lbfgs_memory"] = opt.lbfgs_memory;
   j["scene_id"] = id;
   j["strain_increment"] = opt.strain_increment;
   j["affine"] = opt.affine;

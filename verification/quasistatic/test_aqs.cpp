@@ -31,8 +31,10 @@ SceneConfig pair_config() { return test::iron_pair_config(R, M, 15e-6); }
 // the dipole load F(2R - h) of the shifted-force law. The closed form
 // h = (F/k)^{2/3} with F at the final separation is solved by fixed point.
 // At an accepted minimum |k h^{3/2} - F| < tol on each sphere, so
-// |h - h*| < tol / (dF_net/dh) = tol / (k_eff - |dF/dr|).
-TEST(QuasistaticHertz, PairRelaxesToClosedFormOverlap) {
+// |h - h*| < tol / (dF_net/dh) = tol / (k_eff - |dF/dr|). Both minimisers.
+class QuasistaticHertz : public ::testing::TestWithParam<Minimiser> {};
+
+TEST_P(QuasistaticHertz, PairRelaxesToClosedFormOverlap) {
   const DemParams p = dem_params(pair_config());
   const double rc = p.dipole_cutoff, k = p.hertz_k;
   const auto load = [&](double h) { return -shifted_dipole_force_x(Vec3(2 * R - h, 0, 0), p.dipole_pref, rc).x(); };
@@ -46,22 +48,27 @@ TEST(QuasistaticHertz, PairRelaxesToClosedFormOverlap) {
     cell.free.x = {Vec3(-1.3 * R, 20e-6, 20e-6), Vec3(1.3 * R, 20e-6, 20e-6 + 0.3 * R)};
     QuasistaticOptions o;
     o.force_tol = tol;
-    const FireOptions fire = quasistatic_fire_options(p, o);
+    o.minimiser = GetParam();
+    const MinimiserOptions m = quasistatic_minimiser_options(p, o);
+    const double force_tol = m.force_tol();
     QuasistaticState s = make_quasistatic_state(cell, p, rc);
-    const FireResult r = relax(s, fire, 0, 0.0);
+    const Relaxation r = relax(s, m, 0, 0.0);
     ASSERT_TRUE(r.converged);
     const QuasistaticPoint pt = measure(s);
-    EXPECT_LT(pt.max_force, fire.force_tol);
+    EXPECT_LT(pt.max_force, force_tol);
     const Vec3 d = s.cell.free.x[1] - s.cell.free.x[0];
     const double h = 2 * R - d.norm();
     EXPECT_NEAR(h, pt.max_overlap, 1e-15);
-    const double bound = fire.force_tol / stiffness;
+    const double bound = force_tol / stiffness;
     EXPECT_NEAR(h, h_star, bound) << "tol " << tol << " after " << r.iterations << " iterations";
-    EXPECT_LT(std::abs(d.z()) + std::abs(d.y()), 1e-3 * R + 2 * R * fire.force_tol / load(h_star));  // aligned
-    std::printf("  tol %.0e F0: h = %.9e m, h* = %.9e m, |h-h*| = %.2e m (bound %.2e), %ld iterations\n", tol, h,
+    EXPECT_LT(std::abs(d.z()) + std::abs(d.y()), 1e-3 * R + 2 * R * force_tol / load(h_star));  // aligned
+    std::printf("  %s, tol %.0e F0: h = %.9e m, h* = %.9e m, |h-h*| = %.2e m (bound %.2e), %ld iterations\n", minimiser_name(GetParam()), tol, h,
                 h_star, std::abs(h - h_star), bound, r.iterations);
   }
 }
+
+std::string param_name(const ::testing::TestParamInfo<Minimiser>& p) { return minimiser_name(p.param); }
+INSTANTIATE_TEST_SUITE_P(Minimisers, QuasistaticHertz, ::testing::Values(Minimiser::fire, Minimiser::lbfgs), param_name);
 
 // numerics.threads holds for the driver as for `mrf run` (it once did not:
 // every quasi-static run took all cores, on a machine shared with sweeps).
@@ -89,9 +96,10 @@ QuasistaticOptions smoke_options() {
 // (k_eff ~ Y^{2/3}, iterations ~ sqrt of the stiffness ratio): the fast case
 // runs at Y/100 (max overlap ~ 7e-3 R, REFERENCE §8), the slow one at the
 // scene's 200 GPa.
-void smoke_run(const std::vector<std::string>& overrides) {
+void smoke_run(const std::vector<std::string>& overrides, Minimiser minimiser = Minimiser::fire) {
   const LoadedScene scene = test::scene(overrides);
-  const QuasistaticOptions o = smoke_options();
+  QuasistaticOptions o = smoke_options();
+  o.minimiser = minimiser;
   std::size_t seen = 0;
   const QuasistaticResult r = run_quasistatic(scene, o, [&](const QuasistaticPoint& pt) {
     EXPECT_EQ(pt.increment, seen++);
@@ -116,7 +124,7 @@ void smoke_run(const std::vector<std::string>& overrides) {
   }
   EXPECT_GT(r.iterations[0], 100);  // the random packing is far from a minimum
   EXPECT_GT(r.steady_wall.samples, 0);
-  std::printf("  small scene: %.2f s, %ld force evaluations, %ld list builds; iterations per minimum:", r.wall_seconds,
+  std::printf("  small scene, %s: %.2f s, %ld force evaluations, %ld list builds; iterations per minimum:", minimiser_name(minimiser), r.wall_seconds,
               r.force_evaluations, r.list_builds);
   for (long it : r.iterations) std::printf(" %ld", it);
   std::printf("\n  stress (Pa): wall");
@@ -129,7 +137,13 @@ void smoke_run(const std::vector<std::string>& overrides) {
 
 TEST(QuasistaticSmallScene, SmokeAndInvariantsReducedModulus) { smoke_run({"contact.youngs_modulus=\"2 GPa\""}); }
 
+TEST(QuasistaticSmallScene, SmokeAndInvariantsReducedModulusLbfgs) {
+  smoke_run({"contact.youngs_modulus=\"2 GPa\""}, Minimiser::lbfgs);
+}
+
 TEST(QuasistaticSmallScene, SlowSmokeAndInvariantsRealModulus) { smoke_run({}); }
+
+TEST(QuasistaticSmallScene, SlowSmokeAndInvariantsRealModulusLbfgs) { smoke_run({}, Minimiser::lbfgs); }
 
 TEST(QuasistaticSmallScene, UnconvergedMinimisationStopsTheRun) {
   QuasistaticOptions o = smoke_options();
@@ -214,6 +228,9 @@ TEST(QuasistaticResume, RestoredRunContinuesBitForBitAndExtends) {
   QuasistaticOptions other = o;
   other.strain_increment = 5e-4;
   expect_refused(scene, other, ckpt, "quasistatic.strain_increment");
+  other = o;
+  other.minimiser = Minimiser::lbfgs;
+  expect_refused(scene, other, ckpt, "quasistatic.minimiser");
 }
 
 // A branch (load with branch = true) takes another run's checkpoint at
@@ -260,6 +277,25 @@ TEST(QuasistaticResume, BranchAtAnotherToleranceStartsFromTheSameMinimum) {
   QuasistaticOptions t = o;
   t.force_tol = 1e-6;
   expect_refused(scene, t, ckpt, "quasistatic.force_tol");
+
+  // A branch may also change the minimiser: L-BFGS goes on from FIRE's
+  // second minimum, and every later minimum meets the tolerance.
+  QuasistaticOptions l = o;
+  l.minimiser = Minimiser::lbfgs;
+  QuasistaticRun run = quasistatic_run(scene, l);
+  {
+    ArchiveReader in(ckpt);
+    run.load(in, true);
+    in.expect_end();
+  }
+  while (!run.done()) run.step();
+  const QuasistaticResult lb = run.finish();
+  ASSERT_EQ(lb.strain.size(), straight.strain.size());
+  for (std::size_t k = 0; k < 2; ++k) EXPECT_EQ(lb.stress_wall[k], straight.stress_wall[k]) << "minimum " << k;
+  for (std::size_t k = 2; k < lb.strain.size(); ++k) {
+    EXPECT_LT(lb.max_force[k], o.force_tol * lb.force_scale) << "minimum " << k;
+    EXPECT_LE(std::abs(lb.stress_wall[k] - lb.stress_virial[k]), lb.equilibrium_bound) << "minimum " << k;
+  }
 }
 
 TEST(QuasistaticOptions, BadValuesNameTheirKey) {
@@ -285,6 +321,16 @@ TEST(QuasistaticOptions, BadValuesNameTheirKey) {
   o = {};
   o.max_iterations = 0;
   EXPECT_EQ(key_of(o), "quasistatic.max_iterations");
+  o = {};
+  o.lbfgs_memory = 0;
+  EXPECT_EQ(key_of(o), "quasistatic.lbfgs_memory");
+  try {
+    (void)parse_minimiser("cg", "--minimiser");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), "--minimiser");
+    EXPECT_NE(std::string(e.what()).find("fire or lbfgs"), std::string::npos) << e.what();
+  }
   // a cut-off beyond the minimum image of the small box (32 um)
   o = smoke_options();
   o.dipole_cutoff = 20e-6;

@@ -93,6 +93,14 @@ OrbitMean orbit_mean(const std::vector<double>& y, std::size_t first, std::size_
   return o;
 }
 
+const char* minimiser_name(Minimiser m) { return m == Minimiser::lbfgs ? "lbfgs" : "fire"; }
+
+Minimiser parse_minimiser(const std::string& text, const std::string& key) {
+  if (text == "fire") return Minimiser::fire;
+  if (text == "lbfgs") return Minimiser::lbfgs;
+  throw InputError(key, text, "", "must be fire or lbfgs");
+}
+
 void QuasistaticOptions::validate() const {
   require(strain_increment > 0 && strain_increment <= 0.1, "strain_increment", strain_increment,
           "must be in (0, 0.1] (a quasi-static increment)");
@@ -102,6 +110,7 @@ void QuasistaticOptions::validate() const {
             "must be >= 0 and < quasistatic.strain");
   require(force_tol > 0 && force_tol < 1, "force_tol", force_tol, "must be in (0, 1) (a fraction of F0)");
   require(max_iterations > 0, "max_iterations", static_cast<double>(max_iterations), "must be > 0");
+  require(lbfgs_memory >= 1 && lbfgs_memory <= 1000, "lbfgs_memory", lbfgs_memory, "must be in [1, 1000]");
   require(dipole_cutoff >= 0, "dipole_cutoff", dipole_cutoff, "must be >= 0 (0: particles.dipole_cutoff)");
   require(dt_max_over_tk > 0 && dt_max_over_tk <= 1, "dt_max_over_tk", dt_max_over_tk, "must be in (0, 1]");
   require(dt_start_over_tk > 0 && dt_start_over_tk <= dt_max_over_tk, "dt_start_over_tk", dt_start_over_tk,
@@ -140,12 +149,14 @@ void apply_strain_increment(QuasistaticState& s, double d_gamma, bool affine) {
     for (Vec3& x : c.free.x) x += couette_velocity(x, d_gamma);  // the same profile, over unit time
 }
 
-FireOptions quasistatic_fire_options(const DemParams& p, const QuasistaticOptions& o) {
+MinimiserOptions quasistatic_minimiser_options(const DemParams& p, const QuasistaticOptions& o) {
   // Contact time scale at a chain's tension, about twice the contact force.
   const double load = 2.0 * p.contact_force;
   const double k_eff = hertz_local_stiffness(hertz_overlap_under_load(load, p.hertz_k), p.hertz_k);
   const double t_k = std::sqrt(p.mass / k_eff);
-  FireOptions f;
+  MinimiserOptions m;
+  m.kind = o.minimiser;
+  FireOptions& f = m.fire;
   f.force_tol = o.force_tol * p.contact_force;
   f.max_iterations = o.max_iterations;
   f.dt_max = o.dt_max_over_tk * t_k;
@@ -153,19 +164,33 @@ FireOptions quasistatic_fire_options(const DemParams& p, const QuasistaticOption
   f.dt_min = std::min(1e-3 * t_k, f.dt_start);
   f.max_step = o.max_step_over_radius * p.radius;
   f.mass = p.mass;
-  return f;
+  LbfgsOptions& l = m.lbfgs;
+  l.force_tol = f.force_tol;
+  l.max_evaluations = o.max_iterations + 1;
+  l.memory = o.lbfgs_memory;
+  l.max_step = f.max_step;
+  l.initial_scale = 1.0 / k_eff;
+  return m;
 }
 
-FireResult relax(QuasistaticState& s, const FireOptions& fire, std::size_t increment, double strain) {
-  const FireResult r = fire_minimize(s.cell.free.x, s.cell.free.f, fire, [&s] {
+Relaxation relax(QuasistaticState& s, const MinimiserOptions& m, std::size_t increment, double strain) {
+  const auto energy = [&s] {
     evaluate_forces(s);
     return s.sums.energy_dipole + s.sums.energy_hertz;
-  });
+  };
+  Relaxation r;
+  if (m.kind == Minimiser::lbfgs) {
+    const LbfgsResult l = lbfgs_minimize(s.cell.free.x, s.cell.free.f, m.lbfgs, energy);
+    r = {l.converged, l.evaluations - 1, l.max_force, l.stop_reason};
+  } else {
+    const FireResult f = fire_minimize(s.cell.free.x, s.cell.free.f, m.fire, energy);
+    r = {f.converged, f.iterations, f.max_force, f.stop_reason};
+  }
   if (!r.converged)
     throw NumericalError("quasistatic: no minimum at increment " + std::to_string(increment) + " (strain " +
-                         format_short(strain) + "): FIRE stopped (" + r.stop_reason + ") after " +
-                         std::to_string(r.iterations) + " iterations with max |f| = " + format_short(r.max_force) +
-                         " N above the tolerance " + format_short(fire.force_tol) +
+                         format_short(strain) + "): " + (m.kind == Minimiser::lbfgs ? "L-BFGS" : "FIRE") + " stopped (" +
+                         r.stop_reason + ") after " + std::to_string(r.iterations) + " iterations with max |f| = " +
+                         format_short(r.max_force) + " N above the tolerance " + format_short(m.force_tol()) +
                          " N; raise quasistatic.max_iterations or lower quasistatic.strain_increment");
   return r;
 }
@@ -191,16 +216,17 @@ QuasistaticRun::QuasistaticRun(ShearCell cell, const DemParams& p, const Quasist
   const double rc = o_.dipole_cutoff > 0 ? o_.dipole_cutoff : p.dipole_cutoff;
   o_.dipole_cutoff = rc;
   check_cutoff(rc, p, cell.box, "quasistatic.dipole_cutoff", "");
-  fire_ = quasistatic_fire_options(p, o_);
-  fire_.validate("quasistatic.fire.");
+  minimiser_ = quasistatic_minimiser_options(p, o_);
+  minimiser_.fire.validate("quasistatic.fire.");
+  minimiser_.lbfgs.validate("quasistatic.lbfgs.");
   s_ = make_quasistatic_state(std::move(cell), p, rc);
   r_.force_scale = p.contact_force;
-  r_.force_tol = fire_.force_tol;
+  r_.force_tol = minimiser_.force_tol();
   r_.dipole_cutoff = rc;
   const Box& box = s_.cell.box;
   r_.stress_scale = static_cast<double>(s_.cell.free.size()) * sphere_volume(p.radius) / box.volume() * k_mu0 *
                     std::pow(p.moment / sphere_volume(p.radius), 2);
-  r_.equilibrium_bound = static_cast<double>(s_.cell.free.size()) * 0.5 * box.gap * fire_.force_tol / box.volume();
+  r_.equilibrium_bound = static_cast<double>(s_.cell.free.size()) * 0.5 * box.gap * minimiser_.force_tol() / box.volume();
   r_.orbit_period_strain = box.lz / box.gap;
   n_increments_ = static_cast<std::size_t>(std::ceil(*o_.strain / o_.strain_increment - 1e-9));
 }
@@ -210,7 +236,7 @@ QuasistaticPoint QuasistaticRun::step() {
   const std::size_t k = next_;
   const double strain = static_cast<double>(k) * o_.strain_increment;
   if (k > 0) apply_strain_increment(s_, o_.strain_increment, o_.affine);
-  const FireResult fr = relax(s_, fire_, k, strain);
+  const Relaxation fr = relax(s_, minimiser_, k, strain);
   QuasistaticPoint pt = measure(s_);
   pt.increment = k;
   pt.strain = strain;
@@ -234,15 +260,16 @@ QuasistaticResult QuasistaticRun::finish() {
 }
 
 void QuasistaticRun::save(ArchiveWriter& out) const {
-  out.io(o_.strain_increment, o_.force_tol, static_cast<std::uint8_t>(o_.affine), o_.dipole_cutoff);
+  out.io(o_.strain_increment, o_.force_tol, static_cast<std::uint8_t>(o_.affine), o_.dipole_cutoff,
+         static_cast<std::uint8_t>(o_.minimiser));
   serialize(out, *this);
   out.put(wall_seconds());
 }
 
 void QuasistaticRun::load(ArchiveReader& in, bool branch) {
   double increment = 0, tol = 0, cutoff = 0;
-  std::uint8_t affine = 0;
-  in.io(increment, tol, affine, cutoff);
+  std::uint8_t affine = 0, minimiser = 0;
+  in.io(increment, tol, affine, cutoff, minimiser);
   const auto refuse = [&](const std::string& key, const std::string& saved, const std::string& now) {
     throw NumericalError("checkpoint " + in.path() + " was written with quasistatic." + key + " = " + saved +
                          ", this run asks for " + now + ": start a new run (another --out) or resume with the same value");
@@ -250,6 +277,10 @@ void QuasistaticRun::load(ArchiveReader& in, bool branch) {
   if (increment != o_.strain_increment) refuse("strain_increment", format_short(increment), format_short(o_.strain_increment));
   if (tol != o_.force_tol && !branch) refuse("force_tol", format_short(tol), format_short(o_.force_tol));
   if ((affine != 0) != o_.affine) refuse("affine", affine ? "on" : "off", o_.affine ? "on" : "off");
+  if (minimiser > static_cast<std::uint8_t>(Minimiser::lbfgs))
+    throw NumericalError("checkpoint " + in.path() + " is damaged: minimiser code " + std::to_string(minimiser));
+  if (static_cast<Minimiser>(minimiser) != o_.minimiser && !branch)
+    refuse("minimiser", minimiser_name(static_cast<Minimiser>(minimiser)), minimiser_name(o_.minimiser));
   if (cutoff != o_.dipole_cutoff) refuse("dipole_cutoff", format_short(cutoff) + " m", format_short(o_.dipole_cutoff) + " m");
   const std::size_t n_free = s_.cell.free.size(), n_wall = s_.cell.walls.size();
   serialize(in, *this);

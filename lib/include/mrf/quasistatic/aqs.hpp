@@ -7,7 +7,9 @@
 // the standard AQS start point, it removes most of the elastic relaxation
 // the minimiser would otherwise do), then the free particles are relaxed to
 // a local minimum of the dipole + Hertz energy by FIRE 2.0
-// (quasistatic/fire.hpp) until the largest force on a free particle is below
+// (quasistatic/fire.hpp; the default) or L-BFGS (quasistatic/lbfgs.hpp;
+// quasistatic.minimiser, reports/quasistatic/minimiser.md compares them)
+// until the largest force on a free particle is below
 // force_tol F0, F0 = (pi/6) mu0 R^2 M^2 the head-to-tail dipole force at
 // contact (REFERENCE TEST 1.1). The dipole law is the shifted-force form of
 // quasistatic/shifted_dipole.hpp (continuous energy and force at the
@@ -33,25 +35,33 @@
 #include "mrf/observe/block_average.hpp"
 #include "mrf/params.hpp"
 #include "mrf/quasistatic/fire.hpp"
+#include "mrf/quasistatic/lbfgs.hpp"
 #include "mrf/quasistatic/shifted_dipole.hpp"
 #include "mrf/scene/dem_forces.hpp"
 #include "mrf/scene/shear_cell.hpp"
 
 namespace mrf {
 
+enum class Minimiser { fire, lbfgs };
+const char* minimiser_name(Minimiser m);  // "fire", "lbfgs"
+// InputError naming `key` and the accepted names on anything else.
+Minimiser parse_minimiser(const std::string& text, const std::string& key);
+
 struct QuasistaticOptions {
+  Minimiser minimiser = Minimiser::fire;
   double strain_increment = 1e-3;      // d_gamma per increment
   std::optional<double> strain;        // total strain; default the scene's drive.strain
   std::optional<double> warmup_strain; // excluded from the steady mean; default drive.warmup_strain
   bool affine = true;                  // affine displacement d_gamma x of the free particles
   double force_tol = 1e-6;             // accepted minimum: max |f_i| < force_tol F0
-  long max_iterations = 200000;        // FIRE iterations allowed per minimisation
+  long max_iterations = 200000;        // force evaluations allowed per minimisation after the first
+  int lbfgs_memory = 10;               // L-BFGS correction pairs
   double dipole_cutoff = 0;            // r_c of the shifted-force law (m); 0 = particles.dipole_cutoff
   // FIRE step sizes relative to the contact time scale t_k = sqrt(m_p / k_eff),
   // k_eff = dF/dh of Hertz at twice the contact force (a chain's tension):
   double dt_max_over_tk = 0.4;         // semi-implicit Euler is stable below ~0.58 t_k with 6 contacts
   double dt_start_over_tk = 0.04;
-  double max_step_over_radius = 0.05;  // largest displacement of one particle per FIRE iteration / R
+  double max_step_over_radius = 0.05;  // largest displacement of one particle per iteration / R (both minimisers)
 
   // InputError naming quasistatic.<field> on a bad value.
   void validate() const;
@@ -68,7 +78,7 @@ struct QuasistaticPoint {
   double energy = 0;                 // J, shifted dipole + Hertz
   double max_force = 0;              // N, max |f_i| over the free particles
   double max_overlap = 0;            // m
-  long iterations = 0;               // FIRE iterations of this minimisation
+  long iterations = 0;               // force evaluations of this minimisation after the first
 };
 
 // A periodic orbit in a series sampled at equal strain steps: the walls
@@ -129,12 +139,29 @@ void evaluate_forces(QuasistaticState& s);
 // Walls by +-(gap/2) d_gamma in z; with `affine`, each free particle by d_gamma x.
 void apply_strain_increment(QuasistaticState& s, double d_gamma, bool affine);
 
-// FIRE options of a scene: tolerances and steps from DemParams (see the fields above).
-FireOptions quasistatic_fire_options(const DemParams& p, const QuasistaticOptions& o);
+// The minimiser of a scene and its settings: tolerances and steps from
+// DemParams (see the fields above). L-BFGS takes the same tolerance, budget
+// and step cap as FIRE, and 1/k_eff (the inverse contact stiffness FIRE's
+// steps are scaled by) as its first inverse-Hessian guess.
+struct MinimiserOptions {
+  Minimiser kind = Minimiser::fire;
+  FireOptions fire;
+  LbfgsOptions lbfgs;
+  double force_tol() const { return fire.force_tol; }  // N, the same for both
+};
+MinimiserOptions quasistatic_minimiser_options(const DemParams& p, const QuasistaticOptions& o);
+
+// What one minimisation did, either minimiser.
+struct Relaxation {
+  bool converged = false;
+  long iterations = 0;      // force evaluations after the first (FIRE: its MD steps)
+  double max_force = 0;     // N
+  std::string stop_reason;
+};
 
 // Relax to a minimum; NumericalError (naming increment, strain, iterations,
-// max |f| and the tolerance) if FIRE stops without convergence.
-FireResult relax(QuasistaticState& s, const FireOptions& fire, std::size_t increment, double strain);
+// max |f| and the tolerance) if the minimiser stops without convergence.
+Relaxation relax(QuasistaticState& s, const MinimiserOptions& m, std::size_t increment, double strain);
 
 // The observables of the current (relaxed) state.
 QuasistaticPoint measure(const QuasistaticState& s);
@@ -156,22 +183,22 @@ class QuasistaticRun {
   std::size_t increments() const { return n_increments_; }  // the last increment; 0 is the initial minimum
   const QuasistaticOptions& options() const { return o_; }  // as run: the cut-off resolved
   // Applies the next increment (none for the initial minimum), relaxes to a
-  // minimum and records it; NumericalError if FIRE does not converge.
+  // minimum and records it; NumericalError if the minimiser does not converge.
   QuasistaticPoint step();
   const QuasistaticResult& series() const { return r_; }  // the minima so far
   double wall_seconds() const;  // so far, over every session of a resumed run
   // The steady means over the minima so far and the final cell; the run is spent.
   QuasistaticResult finish();
 
-  // The increment, tolerance, affine start and cut-off are part of the
-  // state: load() refuses (NumericalError naming the option and both values)
-  // a checkpoint written with others. The total strain may differ: a run
-  // is extended by resuming it with a larger one.
+  // The increment, tolerance, affine start, cut-off and minimiser are part
+  // of the state: load() refuses (NumericalError naming the option and both
+  // values) a checkpoint written with others. The total strain may differ:
+  // a run is extended by resuming it with a larger one.
   // branch: a new run from another run's checkpoint, whose force tolerance
-  // may differ (the others may not): its minima so far are the other
-  // run's, each later one at this run's tolerance, so the two tolerances
-  // are compared along one path from the same minimum; its wall time
-  // starts at 0.
+  // and minimiser may differ (the others may not): its minima so far are the
+  // other run's, each later one with this run's settings, so two
+  // tolerances or minimisers are compared along one path from the same
+  // minimum; its wall time starts at 0.
   void save(ArchiveWriter& out) const;
   void load(ArchiveReader& in, bool branch = false);
 
@@ -185,7 +212,7 @@ class QuasistaticRun {
   }
   QuasistaticState s_;
   QuasistaticOptions o_;
-  FireOptions fire_;
+  MinimiserOptions minimiser_;
   QuasistaticResult r_;
   std::size_t n_increments_ = 0, next_ = 0;
   double seconds_before_ = 0;  // wall seconds of earlier sessions (resumed runs)
