@@ -3,7 +3,7 @@
 //   mrf criterion SWEEP_DIR|RUN_DIR [--thresholds FILE]
 //   mrf quasistatic SCENE.toml [--set k=v]... [--out DIR] [--increment D] [--tol T] [--strain S] [--warmup W]
 //             [--cutoff R] [--no-affine] [--minimiser fire|lbfgs] [--lbfgs-memory M] [--resume]
-//             [--branch-from CHECKPOINT] [--checkpoint-every S]
+//             [--branch-from CHECKPOINT] [--start-from FRAMES] [--checkpoint-every S]
 //   mrf sweep SWEEP.toml [--out DIR] [--quiet] [--estimate | --list | --collect] [--point K | --rank R --ranks K]
 //             [--checkpoint-every S] [--archive DIR]   (mpirun -n K: master-worker schedule)
 // Exit status: 0 done, 2 bad input, 3 numerical failure or refused
@@ -228,6 +228,9 @@ int main(int argc, char** argv) {
   qs->add_option("--branch-from", qs_cli.branch_from,
                  "start from another run's checkpoint.bin (same scene and settings but --tol and --minimiser): a "
                  "pathwise test of either from one minimum");
+  qs->add_option("--start-from", qs_cli.start_from,
+                 "relax the first minimum from the last frame of a frames.xyz of `mrf run` on the same scene "
+                 "(output.frames > 0): a structure made by flow instead of the random packing");
   qs->add_flag("--resume", qs_cli.resume,
                "continue from OUT/checkpoint.bin (same scene and options; a larger --strain extends a finished run)");
   qs->add_option("--checkpoint-every", qs_cli.checkpoint_seconds,

@@ -14,6 +14,10 @@
 // new run (a new --out) from another run's checkpoint at another --tol or
 // --minimiser, everything else the same: both then go on from one minimum,
 // a pathwise comparison; OUT/branch.json and summary.json's branched_from say where.
+// --start-from FRAMES relaxes the first minimum from the last frame of an
+// `mrf run` of the same scene (a structure made by flow) instead of from the
+// random packing; summary.json's started_from names the file and the
+// frame's time.
 #include "quasistatic_command.hpp"
 
 #include <cstdio>
@@ -59,7 +63,9 @@ int quasistatic_command(const std::string& scene_path, const std::vector<std::st
   if (out.empty()) out = "out/" + std::filesystem::path(scene_path).stem().string() + "_quasistatic";
   if (!(cli.checkpoint_seconds >= 0))
     throw mrf::InputError("--checkpoint-every", std::to_string(cli.checkpoint_seconds), "", "must be >= 0 (0 = none)");
-  mrf::QuasistaticRun run = mrf::quasistatic_run(scene, options);
+  if (!cli.start_from.empty() && !cli.branch_from.empty())
+    throw mrf::InputError("--start-from", cli.start_from, "", "cannot be combined with --branch-from (a branch starts from its checkpoint)");
+  mrf::QuasistaticRun run = mrf::quasistatic_run(scene, options, cli.start_from);
   const mrf::QuasistaticOptions& opt = run.options();
   const std::string id = mrf::scene_id(scene.config), ckpt = out + "/checkpoint.bin";
   std::filesystem::create_directories(out);
@@ -100,6 +106,14 @@ int quasistatic_command(const std::string& scene_path, const std::vector<std::st
                    run.next_increment(), run.increments(), run.wall_seconds());
   } else if (!cli.resume && std::filesystem::exists(ckpt)) {
     throw mrf::InputError("--out", out, "", "holds a checkpoint of an earlier run: --resume continues it, or choose another --out");
+  }
+  if (!cli.start_from.empty() && !resuming) {
+    nlohmann::ordered_json st;  // what summary.json reports of the start, also after a --resume
+    st["frames"] = cli.start_from;
+    st["time"] = mrf::read_last_frame(cli.start_from, "--start-from").time;
+    mrf::write_file_atomic(out + "/start.json", st.dump(2) + "\n");
+  } else if (!resuming) {
+    std::filesystem::remove(out + "/start.json");  // of an earlier run in this --out
   }
   if (!cli.quiet)
     std::fprintf(stderr, "mrf quasistatic: %s, increments of %g to strain %g, max |f| < %g F0, affine %s, %s\n",
@@ -161,6 +175,8 @@ int quasistatic_command(const std::string& scene_path, const std::vector<std::st
   j["wall_seconds"] = r.wall_seconds;
   if (std::ifstream branch(out + "/branch.json"); branch)  // minima up to its increment are the parent run's
     j["branched_from"] = nlohmann::ordered_json::parse(branch);
+  if (std::ifstream start(out + "/start.json"); start)  // the first minimum was relaxed from a frame of mrf run
+    j["started_from"] = nlohmann::ordered_json::parse(start);
   j["seed"] = scene.config.seed;
   j["version"] = mrf::version();
   j["git_revision"] = mrf::git_revision();

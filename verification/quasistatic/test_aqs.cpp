@@ -10,10 +10,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 
 #include "mrf/error.hpp"
 #include "mrf/forces/hertz.hpp"
 #include "mrf/quasistatic/aqs.hpp"
+#include "mrf/scene/run_series.hpp"
 #include "mrf/io/archive.hpp"
 #include "support/files.hpp"
 #include "support/iron_pair.hpp"
@@ -296,6 +298,63 @@ TEST(QuasistaticResume, BranchAtAnotherToleranceStartsFromTheSameMinimum) {
     EXPECT_LT(lb.max_force[k], o.force_tol * lb.force_scale) << "minimum " << k;
     EXPECT_LE(std::abs(lb.stress_wall[k] - lb.stress_virial[k]), lb.equilibrium_bound) << "minimum " << k;
   }
+}
+
+// --start-from: the last frame of a frames.xyz replaces the built
+// positions. Started from the frame of another run's last minimum, the
+// first minimum is that minimum again (to the tolerance: its stress within
+// the static-equilibrium bound, in a few evaluations instead of the
+// thousands from the packing); the earlier frame in the file is ignored.
+TEST(QuasistaticStart, FromTheLastFrameOfAFramesFile) {
+  const LoadedScene scene = test::scene({"contact.youngs_modulus=\"2 GPa\""});
+  QuasistaticOptions o = smoke_options();
+  o.strain = 2e-3;
+  o.force_tol = 1e-6;
+  const QuasistaticResult parent = run_quasistatic(scene, o);
+  test::TempDir dir("aqs_start");
+  const std::string frames = (dir.path() / "frames.xyz").string();
+  {
+    std::ofstream out(frames);
+    write_frame(out, build_shear_cell(scene.config), R, 0.0);  // an earlier frame: the packing
+    write_frame(out, parent.final_cell, R, 1.5);
+  }
+  const Frame f = read_last_frame(frames, "--start-from");
+  EXPECT_EQ(f.time, 1.5);
+  ASSERT_EQ(f.free.size(), parent.final_cell.free.size());
+  for (std::size_t i = 0; i < f.free.size(); ++i)
+    ASSERT_EQ(f.free[i], parent.final_cell.free.x[i]) << "sphere " << i;  // exact: 17 digits
+  QuasistaticOptions one = o;
+  one.strain = 1e-3;
+  QuasistaticRun run = quasistatic_run(scene, one, frames);
+  const QuasistaticPoint first = run.step();
+  EXPECT_NEAR(first.stress_wall, parent.stress_wall.back(), 2 * parent.equilibrium_bound);
+  EXPECT_LT(first.iterations, parent.iterations[0] / 20) << "from the packing: " << parent.iterations[0];
+  std::printf("  from the frame: %ld iterations (from the packing %ld); wall stress %.4f Pa against %.4f Pa\n",
+              first.iterations, parent.iterations[0], first.stress_wall, parent.stress_wall.back());
+
+  // A frame of another cell, and a file that is not a frames file.
+  const std::string small = (dir.path() / "pair.xyz").string(), broken = (dir.path() / "broken.xyz").string();
+  {
+    ShearCell pair;
+    pair.box = Box{100e-6, 40e-6, 40e-6};
+    pair.free.x = {Vec3(0, 1e-5, 1e-5), Vec3(6e-6, 1e-5, 1e-5)};
+    std::ofstream out(small);
+    write_frame(out, pair, R, 0.0);
+    std::ofstream bad(broken);
+    bad << "2\nTime=0\nFe 0 0 0 2.5e-6\nNi 1 1 1 2.5e-6\n";
+  }
+  const auto message = [&](const std::string& path) {
+    try {
+      (void)quasistatic_run(scene, one, path);
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.key(), "--start-from");
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message(small).find("2 free and 0 wall spheres"), std::string::npos) << message(small);
+  EXPECT_NE(message(broken).find("line 4"), std::string::npos) << message(broken);
+  EXPECT_NE(message(broken).find("'Ni'"), std::string::npos) << message(broken);
 }
 
 TEST(QuasistaticOptions, BadValuesNameTheirKey) {

@@ -16,6 +16,7 @@
 #include "mrf/observe/steady_state.hpp"
 #include "mrf/observe/stress.hpp"
 #include "mrf/scene/dem_params.hpp"
+#include "mrf/scene/run_series.hpp"
 
 namespace mrf {
 
@@ -312,7 +313,7 @@ QuasistaticResult run_quasistatic(ShearCell cell, const DemParams& p, const Quas
   return run_to_end(run, observer);
 }
 
-QuasistaticRun quasistatic_run(const LoadedScene& scene, const QuasistaticOptions& o) {
+QuasistaticRun quasistatic_run(const LoadedScene& scene, const QuasistaticOptions& o, const std::string& start_from) {
   const SceneConfig& c = scene.config;
   if (!(c.magnetization > 0))
     throw InputError("particles.magnetization", format_short(c.magnetization) + " A/m", scene.locate("particles.magnetization"),
@@ -322,7 +323,25 @@ QuasistaticRun quasistatic_run(const LoadedScene& scene, const QuasistaticOption
   QuasistaticOptions opt = o;
   if (!opt.strain) opt.strain = c.strain;
   if (!opt.warmup_strain) opt.warmup_strain = c.warmup_strain;
-  return QuasistaticRun(build_shear_cell(c, scene.locate("particles.volume_fraction")), dem_params(c), opt);
+  ShearCell cell = build_shear_cell(c, scene.locate("particles.volume_fraction"));
+  if (!start_from.empty()) {
+    Frame f = read_last_frame(start_from, "--start-from");
+    if (f.free.size() != cell.free.size() || f.walls.size() != cell.walls.size())
+      throw InputError("--start-from", start_from, "",
+                       "its last frame holds " + std::to_string(f.free.size()) + " free and " +
+                           std::to_string(f.walls.size()) + " wall spheres, the scene builds " +
+                           std::to_string(cell.free.size()) + " and " + std::to_string(cell.walls.size()) +
+                           " (a frame of another scene?)");
+    const double half = 0.5 * cell.box.gap;
+    for (std::size_t i = 0; i < f.free.size(); ++i)
+      if (std::abs(f.free[i].x()) > half)
+        throw InputError("--start-from", start_from, "",
+                         "free sphere " + std::to_string(i) + " lies outside the gap (x = " + format_short(f.free[i].x()) +
+                             " m, |x| must be <= " + format_short(half) + " m)");
+    cell.free.x = std::move(f.free);
+    cell.walls.x = std::move(f.walls);
+  }
+  return QuasistaticRun(std::move(cell), dem_params(c), opt);
 }
 
 QuasistaticResult run_quasistatic(const LoadedScene& scene, const QuasistaticOptions& o,

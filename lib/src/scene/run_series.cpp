@@ -10,6 +10,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <limits>
 #include <string>
 
 #include "mrf/error.hpp"
@@ -131,12 +133,61 @@ void write_series_row(std::ostream& out, double time, double strain, const Serie
 }
 
 void write_frame(std::ostream& out, const ShearCell& cell, double radius, double time) {
+  // max_digits10: the positions read back exactly (mrf quasistatic --start-from).
+  const std::streamsize precision = out.precision(std::numeric_limits<double>::max_digits10);
   out << cell.free.size() + cell.walls.size() << "\n";
   out << "Lattice=\"" << cell.box.gap + 2 * radius << " 0 0 0 " << cell.box.ly << " 0 0 0 " << cell.box.lz
       << "\" Origin=\"" << -0.5 * cell.box.gap - radius
       << " 0 0\" Properties=species:S:1:pos:R:3:radius:R:1 Time=" << time << "\n";
   for (const auto& x : cell.free.x) out << "Fe " << x.x() << " " << x.y() << " " << x.z() << " " << radius << "\n";
   for (const auto& x : cell.walls.x) out << "W " << x.x() << " " << x.y() << " " << x.z() << " " << radius << "\n";
+  out.precision(precision);
+}
+
+Frame read_last_frame(const std::string& path, const std::string& key) {
+  std::ifstream in(path);
+  if (!in) throw InputError(key, path, "", std::string("cannot read: ") + std::strerror(errno));
+  Frame last;
+  bool any = false;
+  long line_no = 0;
+  std::string line;
+  const auto bad = [&](const std::string& why) {
+    return InputError(key, path, "line " + std::to_string(line_no), why + " (expected a frames.xyz of mrf run)");
+  };
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    std::size_t count = 0;
+    {
+      std::istringstream head(line);
+      if (!(head >> count) || count == 0) throw bad("not a particle count: '" + line + "'");
+    }
+    Frame f;
+    if (!std::getline(in, line)) throw bad("frame ends after its count");
+    ++line_no;
+    const std::size_t at = line.find("Time=");
+    if (at == std::string::npos) throw bad("comment line without Time=");
+    f.time = std::strtod(line.c_str() + at + 5, nullptr);
+    for (std::size_t k = 0; k < count; ++k) {
+      if (!std::getline(in, line)) throw bad("frame of " + std::to_string(count) + " spheres ends after " + std::to_string(k));
+      ++line_no;
+      std::istringstream row(line);
+      std::string species;
+      double x = 0, y = 0, z = 0, r = 0;
+      if (!(row >> species >> x >> y >> z >> r) || !std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z))
+        throw bad("not 'species x y z radius' with finite numbers: '" + line + "'");
+      if (species == "Fe")
+        f.free.emplace_back(x, y, z);
+      else if (species == "W")
+        f.walls.emplace_back(x, y, z);
+      else
+        throw bad("species '" + species + "' is neither Fe (free) nor W (wall)");
+    }
+    last = std::move(f);
+    any = true;
+  }
+  if (!any) throw InputError(key, path, "", "holds no frame");
+  return last;
 }
 
 long series_every(const LoadedScene& scene, long steps) {

@@ -27,6 +27,7 @@
 #include <cstddef>
 #include <functional>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "mrf/io/archive.hpp"
@@ -223,7 +224,13 @@ class QuasistaticRun {
 // every model uses), DemParams from dem_params(scene.config), the strain
 // and warm-up of drive.* unless the options set them; a magnetisation of 0
 // is refused (no force scale), as is a cut-off that breaks the minimum image.
-QuasistaticRun quasistatic_run(const LoadedScene& scene, const QuasistaticOptions& o);
+// start_from: a frames.xyz of `mrf run` on the same scene (output.frames);
+// its last frame replaces the built positions of the free and wall spheres,
+// so the first minimum is relaxed from a structure made by flow rather than
+// from the random packing. InputError (key --start-from) when its counts
+// differ from the scene's.
+QuasistaticRun quasistatic_run(const LoadedScene& scene, const QuasistaticOptions& o,
+                               const std::string& start_from = "");
 
 // The whole run on a cell built by hand (tests) or from a scene. `strain` and
 // `warmup_strain` of the options must be set for the first form.

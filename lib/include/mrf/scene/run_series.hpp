@@ -85,8 +85,21 @@ void report_implicit(const ImplicitCounters& c, double time, long steps, RunSumm
 void write_series_header(std::ostream& out);
 void write_series_row(std::ostream& out, double time, double strain, const SeriesRow& row, double radius);
 
-// Extended-XYZ frame of free and wall spheres (OVITO, ParaView).
+// Extended-XYZ frame of free and wall spheres (OVITO, ParaView): the count,
+// a comment line with Lattice, Origin, Properties and Time=, then one line
+// "Fe x y z radius" per free sphere and "W x y z radius" per wall sphere (m),
+// positions to 17 significant digits (they read back exactly).
 void write_frame(std::ostream& out, const ShearCell& cell, double radius, double time);
+
+// The last frame of a frames.xyz that write_frame wrote: free and wall
+// positions in file order, and its Time. InputError naming `key`, the file
+// and the line on a file that is not such a frames file (a short frame, a
+// species other than Fe or W, a count that does not match its lines).
+struct Frame {
+  std::vector<Vec3> free, walls;
+  double time = 0;
+};
+Frame read_last_frame(const std::string& path, const std::string& key);
 
 // Steps between rows (output.every or ~2000 rows) and the check that at
 // least 32 rows follow the warm-up; throws InputError on output.every when
