@@ -218,9 +218,12 @@ int main(int argc, char** argv) {
   qs->add_option("--warmup", qs_warmup, "strain left out of the steady mean (default drive.warmup_strain)");
   qs->add_option("--cutoff", qo.dipole_cutoff, "shifted-force dipole cut-off in m (default particles.dipole_cutoff)");
   std::string qs_minimiser = "fire";
-  qs->add_option("--minimiser", qs_minimiser, "energy minimiser: fire (FIRE 2.0) or lbfgs (L-BFGS)")
+  qs->add_option("--minimiser", qs_minimiser, "energy minimiser: fire (FIRE 2.0), lbfgs (L-BFGS) or descent (steepest descent, the gradient flow)")
       ->capture_default_str();
   qs->add_option("--lbfgs-memory", qo.lbfgs_memory, "L-BFGS correction pairs")->capture_default_str();
+  qs->add_option("--descent-step", qo.descent_step_times_k,
+                 "steepest descent: Euler step of the gradient flow times the contact stiffness k_eff")
+      ->capture_default_str();
   qs->add_option("--max-iterations", qo.max_iterations, "force evaluations per minimisation after the first")
       ->capture_default_str();
   qs->add_flag("--no-affine", no_affine, "free particles not displaced affinely before each minimisation");

@@ -140,9 +140,13 @@ int quasistatic_command(const std::string& scene_path, const std::vector<std::st
   write_checkpoint(run, id, out);  // kept: --resume with a larger --strain extends the run
   const mrf::QuasistaticResult r = run.finish();
   nlohmann::ordered_json j;
-  j["driver"] = opt.minimiser == mrf::Minimiser::lbfgs ? "quasistatic (AQS, L-BFGS)" : "quasistatic (AQS, FIRE 2.0)";
+  j["driver"] = std::string("quasistatic (AQS, ") +
+                (opt.minimiser == mrf::Minimiser::lbfgs     ? "L-BFGS)"
+                 : opt.minimiser == mrf::Minimiser::descent ? "steepest descent)"
+                                                            : "FIRE 2.0)");
   j["minimiser"] = mrf::minimiser_name(opt.minimiser);
   if (opt.minimiser == mrf::Minimiser::lbfgs) j["lbfgs_memory"] = opt.lbfgs_memory;
+  if (opt.minimiser == mrf::Minimiser::descent) j["descent_step_times_k"] = opt.descent_step_times_k;
   j["scene_id"] = id;
   j["strain_increment"] = opt.strain_increment;
   j["affine"] = opt.affine;

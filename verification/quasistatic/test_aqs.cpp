@@ -51,6 +51,7 @@ TEST_P(QuasistaticHertz, PairRelaxesToClosedFormOverlap) {
     QuasistaticOptions o;
     o.force_tol = tol;
     o.minimiser = GetParam();
+    o.max_iterations = 20000000;
     const MinimiserOptions m = quasistatic_minimiser_options(p, o);
     const double force_tol = m.force_tol();
     QuasistaticState s = make_quasistatic_state(cell, p, rc);
@@ -70,7 +71,8 @@ TEST_P(QuasistaticHertz, PairRelaxesToClosedFormOverlap) {
 }
 
 std::string param_name(const ::testing::TestParamInfo<Minimiser>& p) { return minimiser_name(p.param); }
-INSTANTIATE_TEST_SUITE_P(Minimisers, QuasistaticHertz, ::testing::Values(Minimiser::fire, Minimiser::lbfgs), param_name);
+INSTANTIATE_TEST_SUITE_P(Minimisers, QuasistaticHertz,
+                         ::testing::Values(Minimiser::fire, Minimiser::lbfgs, Minimiser::descent), param_name);
 
 // numerics.threads holds for the driver as for `mrf run` (it once did not:
 // every quasi-static run took all cores, on a machine shared with sweeps).
@@ -388,7 +390,7 @@ TEST(QuasistaticOptions, BadValuesNameTheirKey) {
     FAIL() << "no error";
   } catch (const InputError& e) {
     EXPECT_EQ(e.key(), "--minimiser");
-    EXPECT_NE(std::string(e.what()).find("fire or lbfgs"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("fire, lbfgs or descent"), std::string::npos) << e.what();
   }
   // a cut-off beyond the minimum image of the small box (32 um)
   o = smoke_options();

@@ -94,12 +94,20 @@ OrbitMean orbit_mean(const std::vector<double>& y, std::size_t first, std::size_
   return o;
 }
 
-const char* minimiser_name(Minimiser m) { return m == Minimiser::lbfgs ? "lbfgs" : "fire"; }
+const char* minimiser_name(Minimiser m) {
+  switch (m) {
+    case Minimiser::lbfgs: return "lbfgs";
+    case Minimiser::descent: return "descent";
+    case Minimiser::fire: break;
+  }
+  return "fire";
+}
 
 Minimiser parse_minimiser(const std::string& text, const std::string& key) {
   if (text == "fire") return Minimiser::fire;
   if (text == "lbfgs") return Minimiser::lbfgs;
-  throw InputError(key, text, "", "must be fire or lbfgs");
+  if (text == "descent") return Minimiser::descent;
+  throw InputError(key, text, "", "must be fire, lbfgs or descent");
 }
 
 void QuasistaticOptions::validate() const {
@@ -112,6 +120,8 @@ void QuasistaticOptions::validate() const {
   require(force_tol > 0 && force_tol < 1, "force_tol", force_tol, "must be in (0, 1) (a fraction of F0)");
   require(max_iterations > 0, "max_iterations", static_cast<double>(max_iterations), "must be > 0");
   require(lbfgs_memory >= 1 && lbfgs_memory <= 1000, "lbfgs_memory", lbfgs_memory, "must be in [1, 1000]");
+  require(descent_step_times_k > 0 && descent_step_times_k <= 0.5, "descent_step_times_k", descent_step_times_k,
+          "must be in (0, 0.5] (below the stability limit of a sphere in several contacts)");
   require(dipole_cutoff >= 0, "dipole_cutoff", dipole_cutoff, "must be >= 0 (0: particles.dipole_cutoff)");
   require(dt_max_over_tk > 0 && dt_max_over_tk <= 1, "dt_max_over_tk", dt_max_over_tk, "must be in (0, 1]");
   require(dt_start_over_tk > 0 && dt_start_over_tk <= dt_max_over_tk, "dt_start_over_tk", dt_start_over_tk,
@@ -171,6 +181,11 @@ MinimiserOptions quasistatic_minimiser_options(const DemParams& p, const Quasist
   l.memory = o.lbfgs_memory;
   l.max_step = f.max_step;
   l.initial_scale = 1.0 / k_eff;
+  DescentOptions& d = m.descent;
+  d.force_tol = f.force_tol;
+  d.max_evaluations = o.max_iterations + 1;
+  d.step = o.descent_step_times_k / k_eff;
+  d.max_step = f.max_step;
   return m;
 }
 
@@ -183,13 +198,16 @@ Relaxation relax(QuasistaticState& s, const MinimiserOptions& m, std::size_t inc
   if (m.kind == Minimiser::lbfgs) {
     const LbfgsResult l = lbfgs_minimize(s.cell.free.x, s.cell.free.f, m.lbfgs, energy);
     r = {l.converged, l.evaluations - 1, l.max_force, l.stop_reason};
+  } else if (m.kind == Minimiser::descent) {
+    const DescentResult d = descent_minimize(s.cell.free.x, s.cell.free.f, m.descent, energy);
+    r = {d.converged, d.evaluations - 1, d.max_force, d.stop_reason};
   } else {
     const FireResult f = fire_minimize(s.cell.free.x, s.cell.free.f, m.fire, energy);
     r = {f.converged, f.iterations, f.max_force, f.stop_reason};
   }
   if (!r.converged)
     throw NumericalError("quasistatic: no minimum at increment " + std::to_string(increment) + " (strain " +
-                         format_short(strain) + "): " + (m.kind == Minimiser::lbfgs ? "L-BFGS" : "FIRE") + " stopped (" +
+                         format_short(strain) + "): " + minimiser_name(m.kind) + " stopped (" +
                          r.stop_reason + ") after " + std::to_string(r.iterations) + " iterations with max |f| = " +
                          format_short(r.max_force) + " N above the tolerance " + format_short(m.force_tol()) +
                          " N; raise quasistatic.max_iterations or lower quasistatic.strain_increment");
@@ -220,6 +238,7 @@ QuasistaticRun::QuasistaticRun(ShearCell cell, const DemParams& p, const Quasist
   minimiser_ = quasistatic_minimiser_options(p, o_);
   minimiser_.fire.validate("quasistatic.fire.");
   minimiser_.lbfgs.validate("quasistatic.lbfgs.");
+  minimiser_.descent.validate("quasistatic.descent.");
   s_ = make_quasistatic_state(std::move(cell), p, rc);
   r_.force_scale = p.contact_force;
   r_.force_tol = minimiser_.force_tol();
@@ -278,7 +297,7 @@ void QuasistaticRun::load(ArchiveReader& in, bool branch) {
   if (increment != o_.strain_increment) refuse("strain_increment", format_short(increment), format_short(o_.strain_increment));
   if (tol != o_.force_tol && !branch) refuse("force_tol", format_short(tol), format_short(o_.force_tol));
   if ((affine != 0) != o_.affine) refuse("affine", affine ? "on" : "off", o_.affine ? "on" : "off");
-  if (minimiser > static_cast<std::uint8_t>(Minimiser::lbfgs))
+  if (minimiser > static_cast<std::uint8_t>(Minimiser::descent))
     throw NumericalError("checkpoint " + in.path() + " is damaged: minimiser code " + std::to_string(minimiser));
   if (static_cast<Minimiser>(minimiser) != o_.minimiser && !branch)
     refuse("minimiser", minimiser_name(static_cast<Minimiser>(minimiser)), minimiser_name(o_.minimiser));

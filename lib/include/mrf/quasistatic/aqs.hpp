@@ -35,6 +35,7 @@
 #include "mrf/neighbors/verlet_list.hpp"
 #include "mrf/observe/block_average.hpp"
 #include "mrf/params.hpp"
+#include "mrf/quasistatic/descent.hpp"
 #include "mrf/quasistatic/fire.hpp"
 #include "mrf/quasistatic/lbfgs.hpp"
 #include "mrf/quasistatic/shifted_dipole.hpp"
@@ -43,8 +44,8 @@
 
 namespace mrf {
 
-enum class Minimiser { fire, lbfgs };
-const char* minimiser_name(Minimiser m);  // "fire", "lbfgs"
+enum class Minimiser { fire, lbfgs, descent };
+const char* minimiser_name(Minimiser m);  // "fire", "lbfgs", "descent"
 // InputError naming `key` and the accepted names on anything else.
 Minimiser parse_minimiser(const std::string& text, const std::string& key);
 
@@ -57,6 +58,7 @@ struct QuasistaticOptions {
   double force_tol = 1e-6;             // accepted minimum: max |f_i| < force_tol F0
   long max_iterations = 200000;        // force evaluations allowed per minimisation after the first
   int lbfgs_memory = 10;               // L-BFGS correction pairs
+  double descent_step_times_k = 0.1;   // steepest descent: h k_eff (the Euler step of the gradient flow)
   double dipole_cutoff = 0;            // r_c of the shifted-force law (m); 0 = particles.dipole_cutoff
   // FIRE step sizes relative to the contact time scale t_k = sqrt(m_p / k_eff),
   // k_eff = dF/dh of Hertz at twice the contact force (a chain's tension):
@@ -148,6 +150,7 @@ struct MinimiserOptions {
   Minimiser kind = Minimiser::fire;
   FireOptions fire;
   LbfgsOptions lbfgs;
+  DescentOptions descent;
   double force_tol() const { return fire.force_tol; }  // N, the same for both
 };
 MinimiserOptions quasistatic_minimiser_options(const DemParams& p, const QuasistaticOptions& o);

@@ -1,4 +1,5 @@
-// The L-BFGS minimiser (quasistatic/lbfgs.hpp) on problems with known
+// The L-BFGS minimiser (quasistatic/lbfgs.hpp) and steepest descent
+// (quasistatic/descent.hpp) on problems with known
 // minima: an ill-conditioned chain of springs (condition number ~ n^2,
 // closed-form minimum) against FIRE on the same problem, a non-convex
 // Rosenbrock valley, and the failure paths (an energy inconsistent with the
@@ -10,6 +11,7 @@
 #include <limits>
 
 #include "mrf/error.hpp"
+#include "mrf/quasistatic/descent.hpp"
 #include "mrf/quasistatic/fire.hpp"
 #include "mrf/quasistatic/lbfgs.hpp"
 
@@ -158,6 +160,59 @@ TEST(Lbfgs, NonFiniteForceIsANumericalError) {
     return 0.0;
   };
   EXPECT_THROW(lbfgs_minimize(x, f, lbfgs_options(1e-6), force), NumericalError);
+}
+
+// Steepest descent is the explicit Euler path of the gradient flow: on
+// E = sum k_i |x_i|^2 / 2 each particle follows x_n = (1 - h k_i)^n x_0
+// exactly until max |f| < tol, and it stops there; on the spring chain it
+// reaches the closed-form minimum, needing more evaluations than FIRE
+// (it scales with the condition number, FIRE with its square root).
+TEST(Descent, FollowsTheEulerPathOfTheGradientFlowAndConverges) {
+  const std::vector<double> k{1.0, 3.0, 7.0};
+  std::vector<Vec3> x{Vec3(1, -2, 0.5), Vec3(0.3, 0.1, -1), Vec3(2, 2, 2)}, f(3);
+  const std::vector<Vec3> x0 = x;
+  const auto force = [&] {
+    double e = 0;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      f[i] = -k[i] * x[i];
+      e += 0.5 * k[i] * x[i].squaredNorm();
+    }
+    return e;
+  };
+  DescentOptions o;
+  o.force_tol = 1e-9;
+  o.max_evaluations = 100000;
+  o.step = 0.1;
+  o.max_step = 10.0;  // never bites here
+  const DescentResult r = descent_minimize(x, f, o, force);
+  ASSERT_TRUE(r.converged) << r.stop_reason;
+  const double n = static_cast<double>(r.evaluations - 1);  // steps taken
+  for (std::size_t i = 0; i < x.size(); ++i)
+    EXPECT_LT((x[i] - std::pow(1.0 - o.step * k[i], n) * x0[i]).norm(), 1e-12) << "particle " << i;
+  // It stopped at the first step below the tolerance: one step fewer was above it.
+  const double slowest = std::pow(1.0 - o.step * k[0], n - 1) * k[0] * x0[0].norm();
+  EXPECT_GE(slowest, o.force_tol);
+  EXPECT_LT(r.max_force, o.force_tol);
+
+  SpringChain a;
+  DescentOptions c;
+  c.force_tol = 1e-6;
+  c.max_evaluations = 10000000;
+  c.step = 1.0 / 12.0;  // below 2 / lambda_max = 2 / (4k)
+  c.max_step = 1.0;
+  const DescentResult d = descent_minimize(a.x, a.f, c, [&a] { return a.forces(); });
+  ASSERT_TRUE(d.converged) << d.stop_reason;
+  EXPECT_LT(a.error(), std::sqrt(double(a.n)) * 1e-6 / a.lambda_min());
+  SpringChain b;
+  const FireResult fr = fire_minimize(b.x, b.f, fire_options(1e-6), [&b] { return b.forces(); });
+  EXPECT_GT(d.evaluations, 5 * (fr.iterations + 1));
+  std::printf("  chain: steepest descent %ld evaluations, FIRE %ld\n", d.evaluations, fr.iterations + 1);
+  c.max_evaluations = 10;
+  SpringChain e;
+  const DescentResult short_run = descent_minimize(e.x, e.f, c, [&e] { return e.forces(); });
+  EXPECT_FALSE(short_run.converged);
+  EXPECT_EQ(short_run.stop_reason, "max_evaluations");
+  EXPECT_EQ(short_run.evaluations, 10);
 }
 
 TEST(Lbfgs, BadOptionsNameTheirKey) {
