@@ -229,8 +229,8 @@ int main(int argc, char** argv) {
   qs->add_flag("--no-affine", no_affine, "free particles not displaced affinely before each minimisation");
   qs->add_flag("--quiet", qs_cli.quiet, "no progress on stderr");
   qs->add_option("--branch-from", qs_cli.branch_from,
-                 "start from another run's checkpoint.bin (same scene and settings but --tol and --minimiser): a "
-                 "pathwise test of either from one minimum");
+                 "start from another run's checkpoint.bin (same scene and settings but --tol, --minimiser, --increment): a "
+                 "pathwise test of any of them from one minimum");
   qs->add_option("--start-from", qs_cli.start_from,
                  "relax the first minimum from the last frame of a frames.xyz of `mrf run` on the same scene "
                  "(output.frames > 0): a structure made by flow instead of the random packing");

@@ -11,8 +11,8 @@
 // larger --strain extends a finished run. The checkpoint names its scene
 // (scene_id) and options; another scene or increment, tolerance, affine
 // start, cut-off or minimiser is refused. --branch-from CHECKPOINT starts a
-// new run (a new --out) from another run's checkpoint at another --tol or
-// --minimiser, everything else the same: both then go on from one minimum,
+// new run (a new --out) from another run's checkpoint at another --tol,
+// --minimiser or --increment, everything else the same: both then go on from one minimum,
 // a pathwise comparison; OUT/branch.json and summary.json's branched_from say where.
 // --start-from FRAMES relaxes the first minimum from the last frame of an
 // `mrf run` of the same scene (a structure made by flow) instead of from the
@@ -86,7 +86,7 @@ int quasistatic_command(const std::string& scene_path, const std::vector<std::st
     nlohmann::ordered_json b;  // what summary.json reports of the branch, also after a --resume of it
     b["checkpoint"] = cli.branch_from;
     b["increment"] = run.next_increment();
-    b["strain"] = static_cast<double>(run.next_increment()) * opt.strain_increment;
+    b["strain"] = run.series().strain.back() + opt.strain_increment;  // of its first own minimum
     mrf::write_file_atomic(out + "/branch.json", b.dump(2) + "\n");
     if (!cli.quiet)
       std::fprintf(stderr, "mrf quasistatic: branched from %s at increment %zu (minima before it are that run's)\n",

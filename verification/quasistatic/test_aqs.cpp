@@ -302,6 +302,70 @@ TEST(QuasistaticResume, BranchAtAnotherToleranceStartsFromTheSameMinimum) {
   }
 }
 
+// A branch at another increment goes on from the parent's last minimum with
+// its own increment: its strains continue from there, its minima meet the
+// tolerance, and its own checkpoint resumes bit for bit (the branch point
+// is part of the state).
+TEST(QuasistaticResume, BranchAtAnotherIncrementContinuesFromTheParentsLastMinimum) {
+  const LoadedScene scene = test::scene({"contact.youngs_modulus=\"2 GPa\""});
+  QuasistaticOptions o = smoke_options();
+  o.strain = 1e-3;
+  o.force_tol = 1e-4;
+  test::TempDir dir("aqs_branch_increment");
+  const std::string parent_ckpt = (dir.path() / "parent.bin").string(), ckpt = (dir.path() / "branch.bin").string();
+  QuasistaticRun parent = quasistatic_run(scene, o);
+  while (!parent.done()) parent.step();  // minima at strain 0 and 1e-3
+  {
+    ArchiveWriter w(parent_ckpt);
+    parent.save(w);
+    w.close();
+  }
+  const QuasistaticResult p = parent.finish();
+  QuasistaticOptions b = o;
+  b.strain_increment = 5e-4;
+  b.strain = 3e-3;
+  const auto branch = [&] {
+    QuasistaticRun run = quasistatic_run(scene, b);
+    ArchiveReader in(parent_ckpt);
+    run.load(in, true);
+    in.expect_end();
+    return run;
+  };
+  QuasistaticRun straight = branch();
+  EXPECT_EQ(straight.next_increment(), 2u);
+  EXPECT_EQ(straight.increments(), 5u);  // 1.5e-3, 2e-3, 2.5e-3, 3e-3 after the parent's two
+  for (int k = 0; k < 2; ++k) straight.step();
+  {
+    ArchiveWriter w(ckpt);
+    straight.save(w);
+    w.close();
+  }
+  while (!straight.done()) straight.step();
+  const QuasistaticResult r = straight.finish();
+  const std::vector<double> strains{0.0, 1e-3, 1.5e-3, 2e-3, 2.5e-3, 3e-3};
+  ASSERT_EQ(r.strain.size(), strains.size());
+  for (std::size_t k = 0; k < strains.size(); ++k) EXPECT_NEAR(r.strain[k], strains[k], 1e-15) << "minimum " << k;
+  for (std::size_t k = 0; k < 2; ++k) EXPECT_EQ(r.stress_wall[k], p.stress_wall[k]) << "minimum " << k;
+  for (std::size_t k = 2; k < r.strain.size(); ++k) {
+    EXPECT_LT(r.max_force[k], r.force_tol) << "minimum " << k;
+    EXPECT_LE(std::abs(r.stress_wall[k] - r.stress_virial[k]), r.equilibrium_bound) << "minimum " << k;
+  }
+  QuasistaticRun resumed = quasistatic_run(scene, b);
+  {
+    ArchiveReader in(ckpt);
+    resumed.load(in);
+    in.expect_end();
+  }
+  EXPECT_EQ(resumed.increments(), 5u);
+  while (!resumed.done()) resumed.step();
+  const QuasistaticResult again = resumed.finish();
+  ASSERT_EQ(again.strain.size(), r.strain.size());
+  for (std::size_t k = 0; k < r.strain.size(); ++k) {
+    EXPECT_EQ(again.strain[k], r.strain[k]) << "minimum " << k;
+    EXPECT_EQ(again.stress_wall[k], r.stress_wall[k]) << "minimum " << k;
+  }
+}
+
 // --start-from: the last frame of a frames.xyz replaces the built
 // positions. Started from the frame of another run's last minimum, the
 // first minimum is that minimum again (to the tolerance: its stress within

@@ -248,13 +248,22 @@ QuasistaticRun::QuasistaticRun(ShearCell cell, const DemParams& p, const Quasist
                     std::pow(p.moment / sphere_volume(p.radius), 2);
   r_.equilibrium_bound = static_cast<double>(s_.cell.free.size()) * 0.5 * box.gap * minimiser_.force_tol() / box.volume();
   r_.orbit_period_strain = box.lz / box.gap;
-  n_increments_ = static_cast<std::size_t>(std::ceil(*o_.strain / o_.strain_increment - 1e-9));
+  count_increments();
+}
+
+void QuasistaticRun::count_increments() {
+  n_increments_ = first_increment_ + static_cast<std::size_t>(std::ceil(
+                                         std::max(0.0, *o_.strain - first_strain_) / o_.strain_increment - 1e-9));
+}
+
+double QuasistaticRun::strain_of(std::size_t k) const {
+  return first_strain_ + static_cast<double>(k - first_increment_) * o_.strain_increment;
 }
 
 QuasistaticPoint QuasistaticRun::step() {
   if (done()) throw std::logic_error("QuasistaticRun::step after the last increment");
   const std::size_t k = next_;
-  const double strain = static_cast<double>(k) * o_.strain_increment;
+  const double strain = strain_of(k);
   if (k > 0) apply_strain_increment(s_, o_.strain_increment, o_.affine);
   const Relaxation fr = relax(s_, minimiser_, k, strain);
   QuasistaticPoint pt = measure(s_);
@@ -281,7 +290,7 @@ QuasistaticResult QuasistaticRun::finish() {
 
 void QuasistaticRun::save(ArchiveWriter& out) const {
   out.io(o_.strain_increment, o_.force_tol, static_cast<std::uint8_t>(o_.affine), o_.dipole_cutoff,
-         static_cast<std::uint8_t>(o_.minimiser));
+         static_cast<std::uint8_t>(o_.minimiser), static_cast<std::uint64_t>(first_increment_), first_strain_);
   serialize(out, *this);
   out.put(wall_seconds());
 }
@@ -289,12 +298,15 @@ void QuasistaticRun::save(ArchiveWriter& out) const {
 void QuasistaticRun::load(ArchiveReader& in, bool branch) {
   double increment = 0, tol = 0, cutoff = 0;
   std::uint8_t affine = 0, minimiser = 0;
-  in.io(increment, tol, affine, cutoff, minimiser);
+  std::uint64_t first_increment = 0;
+  double first_strain = 0;
+  in.io(increment, tol, affine, cutoff, minimiser, first_increment, first_strain);
   const auto refuse = [&](const std::string& key, const std::string& saved, const std::string& now) {
     throw NumericalError("checkpoint " + in.path() + " was written with quasistatic." + key + " = " + saved +
                          ", this run asks for " + now + ": start a new run (another --out) or resume with the same value");
   };
-  if (increment != o_.strain_increment) refuse("strain_increment", format_short(increment), format_short(o_.strain_increment));
+  if (increment != o_.strain_increment && !branch)
+    refuse("strain_increment", format_short(increment), format_short(o_.strain_increment));
   if (tol != o_.force_tol && !branch) refuse("force_tol", format_short(tol), format_short(o_.force_tol));
   if ((affine != 0) != o_.affine) refuse("affine", affine ? "on" : "off", o_.affine ? "on" : "off");
   if (minimiser > static_cast<std::uint8_t>(Minimiser::descent))
@@ -314,6 +326,14 @@ void QuasistaticRun::load(ArchiveReader& in, bool branch) {
   if (r_.strain.size() != next_)
     throw NumericalError("checkpoint " + in.path() + " is inconsistent: " + std::to_string(r_.strain.size()) +
                          " minima recorded for " + std::to_string(next_) + " increments");
+  if (r_.strain.empty())
+    throw NumericalError("checkpoint " + in.path() + " holds no minimum: it cannot be resumed or branched from");
+  // A branch goes on from the parent's last minimum with its own increment
+  // (the parent's strains before it stay as they were); a plain load keeps
+  // the saved numbering.
+  first_increment_ = branch ? next_ : static_cast<std::size_t>(first_increment);
+  first_strain_ = branch ? r_.strain.back() + o_.strain_increment : first_strain;
+  count_increments();
 }
 
 namespace {

@@ -198,11 +198,13 @@ class QuasistaticRun {
   // of the state: load() refuses (NumericalError naming the option and both
   // values) a checkpoint written with others. The total strain may differ:
   // a run is extended by resuming it with a larger one.
-  // branch: a new run from another run's checkpoint, whose force tolerance
-  // and minimiser may differ (the others may not): its minima so far are the
-  // other run's, each later one with this run's settings, so two
-  // tolerances or minimisers are compared along one path from the same
-  // minimum; its wall time starts at 0.
+  // branch: a new run from another run's checkpoint, whose force tolerance,
+  // minimiser and strain increment may differ (affine start and cut-off may
+  // not): its minima so far are the other run's, each later one with this
+  // run's settings, so two tolerances, minimisers or increments are
+  // compared along one path from the same minimum; its wall time starts at
+  // 0. After a branch at another increment the minima are not equally
+  // spaced in strain across the branch point.
   void save(ArchiveWriter& out) const;
   void load(ArchiveReader& in, bool branch = false);
 
@@ -219,6 +221,13 @@ class QuasistaticRun {
   MinimiserOptions minimiser_;
   QuasistaticResult r_;
   std::size_t n_increments_ = 0, next_ = 0;
+  // Strain of increment k: first_strain_ + (k - first_increment_) d; (0, 0)
+  // unless the run is a branch at another increment d (then the branch
+  // point: the parent's last increment + 1, and its strain + d).
+  std::size_t first_increment_ = 0;
+  double first_strain_ = 0;
+  double strain_of(std::size_t k) const;
+  void count_increments();
   double seconds_before_ = 0;  // wall seconds of earlier sessions (resumed runs)
   std::chrono::steady_clock::time_point t0_;
 };
