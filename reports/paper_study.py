@@ -302,7 +302,10 @@ def main(argv):
                   "(reports/quasistatic/README.md §5).", "",
                   f"**Quoted: {aqs_quote[0]:.4f} ± {aqs_quote[1]:.4f} φμ0M²**, the mean of the {aqs_quote[2]} seeds "
                   f"({', '.join(seed_runs)}) over their common window, its error the standard error of their "
-                  "scatter; the figure's star.", "",
+                  "scatter; the figure's star. The minimiser moves it beyond that scatter (rows lbfgs_*: L-BFGS "
+                  "gives about 40 % less, reports/quasistatic/minimiser.md), so the quasi-static stress of this "
+                  "model is a range by protocol. On the small cell, model 1's dynamic wall stress does not approach "
+                  "the quasi-static one down to Mn = 1e-6 (reports/quasistatic/flow_vs_aqs.md).", "",
                   "| AQS run | stress / (phi mu0 M^2) | note |", "|---|---:|---|"]
         for r in qs:
             lines.append(f"| {r['run']} | {num(r, 'stress_over_phi_mu0_m2'):.5f} ± {num(r, 'err'):.5f} | "

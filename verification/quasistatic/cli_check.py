@@ -7,7 +7,10 @@ with the steady mean, its error and the scene's id. Then the checkpoint:
 the same --out without --resume is refused (exit 2); --resume with
 --strain 0.007 extends the finished run by two minima and leaves the first
 six rows as they were; --resume with another increment is refused (exit 3,
-naming quasistatic.strain_increment).
+naming quasistatic.strain_increment). Then the minimisers: --minimiser lbfgs
+names itself in summary.json and meets the same checks; an unknown minimiser
+is refused (exit 2, naming --minimiser); --start-from a file that is not a
+frames file is refused (exit 2, naming --start-from and the line).
 
 Usage: cli_check.py MRF_BINARY SCENE WORKDIR
 """
@@ -52,5 +55,30 @@ if json.loads((work / "summary.json").read_text())["minima"] != 8:
 other = subprocess.run(base + ["--strain", "0.007", "--increment", "5e-4", "--resume"], capture_output=True, text=True)
 if other.returncode != 3 or "quasistatic.strain_increment" not in other.stderr:
     bad.append(f"--resume with another increment: exit {other.returncode}, stderr {other.stderr.strip()!r}")
+lb = work.parent / (work.name + "_lbfgs")
+shutil.rmtree(lb, ignore_errors=True)
+lb_base = base[:base.index("--out")] + ["--out", str(lb), "--quiet", "--strain", "0.003", "--increment", "1e-3"]
+run = subprocess.run(lb_base + ["--minimiser", "lbfgs"], capture_output=True, text=True)
+if run.returncode != 0:
+    bad.append(f"--minimiser lbfgs: exit {run.returncode}, {run.stderr.strip()}")
+else:
+    ls = json.loads((lb / "summary.json").read_text())
+    lrows = list(csv.DictReader((lb / "quasistatic.csv").open()))
+    if ls.get("minimiser") != "lbfgs" or "L-BFGS" not in ls.get("driver", "") or len(lrows) != 4:
+        bad.append(f"--minimiser lbfgs: minimiser {ls.get('minimiser')!r}, driver {ls.get('driver')!r}, {len(lrows)} rows")
+    for r in lrows:
+        if float(r["max_force"]) >= ls["force_tol"] or \
+                abs(float(r["stress_wall"]) - float(r["stress_virial"])) > ls["equilibrium_bound"]:
+            bad.append(f"--minimiser lbfgs, strain {r['strain']}: not a minimum in equilibrium")
+shutil.rmtree(lb, ignore_errors=True)
+unknown = subprocess.run(lb_base + ["--minimiser", "cg"], capture_output=True, text=True)
+if unknown.returncode != 2 or "--minimiser" not in unknown.stderr:
+    bad.append(f"--minimiser cg: exit {unknown.returncode}, stderr {unknown.stderr.strip()!r}")
+junk = work.parent / (work.name + "_junk.xyz")
+junk.write_text("2\nTime=0\nFe 0 0 0 2.5e-6\n")
+shutil.rmtree(lb, ignore_errors=True)
+start = subprocess.run(lb_base + ["--start-from", str(junk)], capture_output=True, text=True)
+if start.returncode != 2 or "--start-from" not in start.stderr or "line 3" not in start.stderr:
+    bad.append(f"--start-from a short frame: exit {start.returncode}, stderr {start.stderr.strip()!r}")
 print("\n".join(bad) if bad else f"mrf quasistatic: {len(rows)} minima, all checks passed")
 sys.exit(1 if bad else 0)
