@@ -178,6 +178,10 @@ TEST(QuasistaticResume, BranchAtAnotherIncrementContinuesFromTheParentsLastMinim
     load(run, parent_ckpt, true);
     return run;
   };
+  QuasistaticOptions too_short = b;
+  too_short.strain = 1e-3;  // the parent's own end: nothing left to branch
+  QuasistaticRun refused = quasistatic_run(scene, too_short);
+  EXPECT_THROW(load(refused, parent_ckpt, true), NumericalError);
   QuasistaticRun straight = branch();
   EXPECT_EQ(straight.next_increment(), 2u);
   EXPECT_EQ(straight.increments(), 5u);  // 1.5e-3, 2e-3, 2.5e-3, 3e-3 after the parent's two

@@ -333,6 +333,10 @@ void QuasistaticRun::load(ArchiveReader& in, bool branch) {
   // the saved numbering.
   first_increment_ = branch ? next_ : static_cast<std::size_t>(first_increment);
   first_strain_ = branch ? r_.strain.back() + o_.strain_increment : first_strain;
+  if (branch && *o_.strain < first_strain_ - 1e-9 * o_.strain_increment)
+    throw NumericalError("checkpoint " + in.path() + " ends at strain " + format_short(r_.strain.back()) +
+                         ": a branch from it needs quasistatic.strain >= " + format_short(first_strain_) +
+                         " (one increment further), not " + format_short(*o_.strain));
   count_increments();
 }
 
