@@ -56,6 +56,7 @@ def main(argv):
              "base's seed standard deviation). Shift = variant / base - 1, and in combined standard errors.", "",
              "| model | Mn | variant | wall stress | base (seeds) | shift | shift / sigma | particle part shift | "
              "variant steady | s per strain |", "|---|---:|---|---:|---:|---:|---:|---:|---|---:|"]
+    lever = {}  # (model, Mn) -> (|shift|, variant, shift, sigma, steady): the largest mover
     for r in sorted(conv, key=lambda r: (r["model"], float(r["mason"]), r["variant"])):
         key = (r["model"], float(r["mason"]))
         b = base.get(key, [])
@@ -77,9 +78,16 @@ def main(argv):
         pm = statistics.mean(bp)
         vp = (f(r, "stress_total") - f(r, "stress_fluid")) / sc
         z = (t - bm) / math.hypot(be, ve)
+        if abs(t / bm - 1) > lever.get(key, (-1,))[0]:
+            lever[key] = (abs(t / bm - 1), r["variant"], t / bm - 1, z, steady)
         lines.append(f"| {r['model']} | {key[1]:g} | {r['variant']} | {t:.5f} ± {ve:.5f} | {bm:.5f} ± {be:.5f} "
                      f"({len(bt)}) | {100 * (t / bm - 1):+.1f} % | {z:+.1f} | {100 * (vp / pm - 1):+.1f} % | "
                      f"{'yes' if steady else '**no**'} | {per:.3g} |")
+    if lever:
+        lines += ["", "The largest lever per model and Mn (the variant that moves the wall stress most, of those "
+                  "run there; an unsteady variant's shift is not yet a measurement):", ""]
+        for (k, m), (_, v, sh, z, ok) in sorted(lever.items()):
+            lines.append(f"- {k}, Mn {m:g}: {v}, {100 * sh:+.1f} % ({z:+.1f} sigma)" + ("" if ok else ", unsteady"))
     with open(out, "w") as fh:
         fh.write("\n".join(lines) + "\n")
     print(f"-> {out}")

@@ -12,6 +12,7 @@ usage: paper_study.py SWEEP_DIR OUT_DIR [--small reports/study/flow_curves.csv]
                       [--fixed-m-criterion reports/study/paper/fixed_m_criterion.json]
                       [--aqs-seeds headline_0.45,seed2,seed3]
                       [--first-runs reports/study/paper/first_runs] [--note TEXT]
+                      [--small-criterion reports/study/criterion_default.json]
 
 The fixed-M path (experiments/sweeps/paper_fixed_m.toml, collected with
 `mrf sweep ... --archive reports/study/paper/fixed_m_points --collect`, then
@@ -29,6 +30,9 @@ window) with the standard error of their scatter.
 --first-runs: the summaries of the first runs of points re-run for
 steadiness, listed under the steadiness table with what their re-runs gave.
 --note: a paragraph under the title (what state the report is in).
+--small-criterion: mrf criterion's output for the small-cell study, whose
+claims are re-measured on the paper cell (deviations from model 3, model 1's
+volume-side stress, the slope of the flow curve at the lowest Mn).
 
 SWEEP_DIR holds sweep.csv (mrf sweep ... --collect) and criterion.json
 (mrf criterion SWEEP_DIR). Writes OUT_DIR/paper.md and its figures.
@@ -102,6 +106,108 @@ def two_paths(argv, here, crit, phi, models):
             lines.append(f"| {k} | {f['mason']:g} | {f['seeds']} | {t:.4f} ± {e:.4f} | {st:.2g}, {re:.2g} | {cmp_} |")
     lines.append("")
     return lines
+
+
+def old_claims(crit, small_crit, phi, small_m):
+    """The small-cell study's claims (reports/study/study.md, the claims that
+    issue 13 names) against the same quantities on the paper cell. A claim
+    holds at a point when the paper-cell value lies within the claimed range
+    to two standard errors."""
+    if not small_crit:
+        return []
+    dev = {k: {q["mason"]: q for q in v["points"]} for k, v in crit.get("deviation_from_demsph_dd", {}).items()}
+    sdev = {k: {q["mason"]: q for q in v["points"]} for k, v in small_crit.get("deviation_from_demsph_dd", {}).items()}
+    lines = ["## The small-cell study's claims, re-measured on the paper cell", "",
+             "Each claim of reports/study/study.md (375 spheres, fixed M, 2 seeds) against the same quantity "
+             "on the paper cell (realistic path, 3 seeds). D_k = tau_k / tau_3 - 1 (wall stress against model 3 "
+             "at the same Mn, mrf criterion's deviation_from_demsph_dd); 'holds' when the paper-cell value is "
+             "inside the claimed range to 2 standard errors.", "",
+             "| claim | Mn | small cell | paper cell | holds on the paper cell |", "|---|---:|---:|---:|---|"]
+
+    def row(claim, m, sq, pq, lo, hi, key="deviation", err=True):
+        sv = f"{sq[key]:+.3f}" + (f" ± {sq['err']:.3f}" if err else "") if sq else "–"
+        if not pq:
+            return f"| {claim} | {m:g} | {sv} | – | – |"
+        v, e = pq[key], (pq["err"] if err else 0.0)
+        ok = lo - 2 * e <= v <= hi + 2 * e
+        return f"| {claim} | {m:g} | {sv} | {v:+.3f}" + (f" ± {e:.3f}" if err else "") + \
+            f" | {'yes' if ok else '**no**'} |"
+
+    grid = sorted({m for v in dev.values() for m in v})
+    for m in grid:
+        lines.append(row("model 1 is 27-68 % below model 3 at every Mn (D_1 in [-0.68, -0.27])", m,
+                         sdev.get("dem_stokes", {}).get(m), dev.get("dem_stokes", {}).get(m), -0.68, -0.27))
+    for m in [m for m in grid if m <= 1.0]:
+        lines.append(row("models 2 and 3 agree within 10 % up to Mn about 1 (|D_2| <= 0.10)", m,
+                         sdev.get("demsph_stokes", {}).get(m), dev.get("demsph_stokes", {}).get(m), -0.10, 0.10))
+    for m in [m for m in grid if 1e-2 <= m <= 1.0]:
+        lines.append(row("model 1's volume-side stress is within 11 % of model 3 for 1e-2 <= Mn <= 1 "
+                         "(no error: seed means)", m, sdev.get("dem_stokes", {}).get(m),
+                         dev.get("dem_stokes", {}).get(m), -0.11, 0.11, key="volume_deviation", err=False))
+    # "No yield plateau down to Mn = 1e-3": the local slope of the
+    # normalised stress between the two lowest Mn (0 = a plateau, a yield
+    # stress; 1 = Newtonian), for the total and the particle part, beside
+    # the power-law exponent of the flow-curve fit.
+    lines += ["", "The yield plateau: s = d ln(tau / phi mu0 M^2) / d ln Mn between the two lowest Mn "
+              "(s = 0 is a plateau, a Mn-independent yield stress; s = 1 a Newtonian flow), of the total and of "
+              "the particle part, and the power-law fit's Delta (1 = Bingham). The small-cell claim was that "
+              "there is no plateau down to Mn = 1e-3. The last column: is the particle part flat (|s| within 2 "
+              "standard errors of 0)? The total's slope is then the carrier's viscous stress (eta gdot, in these "
+              "units proportional to Mn); the flat particle stress is not the quasi-static value (the AQS section "
+              "below).", "",
+              "| model | cell | Mn pair | s (total) | s (particle part) | Delta (fit) | particle part flat |",
+              "|---|---|---|---:|---:|---:|---|"]
+
+    def slopes(c, k, scale):
+        p = sorted(c["models"].get(k, {}).get("points", []), key=lambda q: q["mason"])
+        if len(p) < 2:
+            return None
+        a, b = p[0], p[1]
+        out = [f"{a['mason']:g}-{b['mason']:g}"]
+        flat = "–"
+        for part in (lambda q: q["stress"], lambda q: q["stress"] - q["stress_fluid"]):
+            va, vb = part(a) / scale(a), part(b) / scale(b)
+            ea, eb = a["err"] / scale(a), b["err"] / scale(b)
+            lr = math.log(b["mason"] / a["mason"])
+            if va <= 0 or vb <= 0:
+                out.append("–")
+                continue
+            sl, se = math.log(vb / va) / lr, math.hypot(ea / va, eb / vb) / lr
+            out.append(f"{sl:+.2f} ± {se:.2f}")
+            flat = "yes" if abs(sl) <= 2 * se else "no"  # the last part: the particle part
+        pw = c["models"][k].get("power_law", {})
+        out.append(f"{pw.get('exponent', float('nan')):.2f} ± {pw.get('exponent_err', float('nan')):.2f}")
+        return out + [flat]
+
+    for k in [m for m in ORDER if m in crit["models"]]:
+        for name, c, scale in (("paper", crit, lambda q: phi * MU0 * q["magnetization"] ** 2),
+                               ("small", small_crit, lambda q: small_crit["volume_fraction"] * MU0 * small_m ** 2)):
+            s = slopes(c, k, scale)
+            if s:
+                lines.append(f"| {k} | {name} | " + " | ".join(s) + " |")
+    lines.append("")
+    return lines
+
+
+def sweep_cost(rows, first_dir):
+    """The wall time of the whole sweep: every run that counts, plus the
+    first runs that the steadiness re-runs replaced."""
+    firsts = []
+    for dirpath, _, files in sorted(os.walk(first_dir)) if os.path.isdir(first_dir) else []:
+        if "summary.json" in files:
+            firsts.append(json.load(open(os.path.join(dirpath, "summary.json"))))
+    per = defaultdict(float)
+    for r in rows:
+        per[r["model"]] += num(r, "wall_seconds")
+    current = {(r["model"], float(r["mason"]), int(r["seed"])): num(r, "strain") for r in rows}
+    # a first run counts only once its re-run (another strain) has replaced it
+    firsts = [f for f in firsts if current.get((f["model"], float(f["mason"]), int(f["seed"]))) not in (None, f["strain"])]
+    first = sum(f.get("wall_seconds", 0.0) for f in firsts)
+    total = sum(per.values()) + first
+    return ["Whole-sweep wall time (one thread per run, summed over runs; shared machine, an upper bound): "
+            + ", ".join(f"{k} {per[k] / 3600:.1f} h" for k in ORDER if k in per)
+            + f", the first runs replaced by re-runs {first / 3600:.1f} h; **{total / 3600:.1f} core-hours** in all "
+            f"({len(rows)} runs counted, {len(firsts)} replaced).", ""]
 
 
 def main(argv):
@@ -253,6 +359,7 @@ def main(argv):
     lines += ["", "Cost: wall seconds per strain unit of each run, one thread, on a shared 2-core machine "
               "(the sweep ran at nice 19 beside other work: an upper bound, not a benchmark; "
               "reports/performance/model_ratios.md has the side-by-side ratios).", ""]
+    lines += sweep_cost(rows, first_dir)
     # ---- wall against volume stress: what the imposed flow of model 1 absorbs --
     lines += ["## Wall and volume-side stress per model", "",
               "Seed means over φμ0M²; volume side = the particle pair virial plus the carrier's part (model 1: "
@@ -335,6 +442,9 @@ def main(argv):
         lines.append(f"| {k} | {b['mason_star']:.3g} ± {b['mason_star_err']:.2g} | "
                      f"{pw['mason_star']:.3g} ± {pw['mason_star_err']:.2g} | {pw['exponent']:.2f} ± "
                      f"{pw['exponent_err']:.2f} | {pw['chi2_dof']:.2g} | {note} |")
+    small_crit_path = arg(argv, "--small-criterion", os.path.join(here, "study", "criterion_default.json"))
+    small_crit = json.load(open(small_crit_path)) if os.path.exists(small_crit_path) else None
+    lines += old_claims(crit, small_crit, phi, small_m)
     lines += two_paths(argv, here, crit, phi, models)
     with open(os.path.join(out, "paper.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
