@@ -88,6 +88,21 @@ def main(argv):
                   "run there; an unsteady variant's shift is not yet a measurement):", ""]
         for (k, m), (_, v, sh, z, ok) in sorted(lever.items()):
             lines.append(f"- {k}, Mn {m:g}: {v}, {100 * sh:+.1f} % ({z:+.1f} sigma)" + ("" if ok else ", unsteady"))
+    # SPH resolution: which spacings the unresolved, locally averaged
+    # coupling admits (REFERENCE.md §6: the averaging assumes h >~ 2 d).
+    radii = [f(x, "radius") for x in base_rows if f(x, "radius") > 0]  # older summaries lack the radius
+    res = sorted({(r["variant"], f(r, "sph_h") / (2 * (f(r, "radius") if f(r, "radius") > 0 else radii[0])))
+                  for r in conv if r["variant"].startswith("sph_") and f(r, "sph_h") > 0 and radii})
+    base_h = sorted({f(x, "sph_h") / (2 * f(x, "radius")) for x in base_rows
+                     if x["model"] != "dem_stokes" and f(x, "sph_h") == f(x, "sph_h")})
+    if res:
+        lines += ["", "SPH resolution against the coupling's validity (REFERENCE.md §6: the local averaging of the "
+                  "unresolved coupling assumes a kernel of at least about 2 particle diameters, h/d >~ 2): "
+                  + "; ".join(f"{v} h/d = {hd:.2f} ({'valid' if hd >= 2 else '**below 2: outside the model**'})"
+                              for v, hd in res)
+                  + (f"; the base h/d = {base_h[0]:.2f}." if base_h else ".")
+                  + " A variant outside the model measures the discretisation, not the physics: its shift is "
+                  "not a convergence error of the base."]
     with open(out, "w") as fh:
         fh.write("\n".join(lines) + "\n")
     print(f"-> {out}")
