@@ -435,13 +435,23 @@ def main(argv):
                          f"{q['err'] / sc:.5f} | {'–' if math.isnan(vol) else f'{vol:.5f}'} |")
         lines.append("")
     lines += ["## Flow-curve fits (mrf criterion)", "",
-              "| model | Bingham Mn* | power-law Mn* | Delta | chi2/dof | note |", "|---|---:|---:|---:|---:|---|"]
+              "eta/eta_inf = 1 + (Mn*/Mn)^Delta fitted to the seed-combined points (Bingham: Delta = 1). The "
+              "Bingham fit's dynamic yield stress is tau_y / (phi mu0 M^2) = eta_r,inf Mn* / (4.5 phi) (REFERENCE.md "
+              "§7, Bi = Mn*/Mn), its error from those of eta_r,inf and Mn* in quadrature (their covariance left out); "
+              "a power law with Delta < 1 has no finite yield stress (tau ~ Mn^(1 - Delta) as Mn -> 0). chi2/dof far "
+              "above 1 says that neither form fits within the points' errors (the errors are then inflated by it). "
+              f"Beside them: the chain model's {CHAIN_YIELD:g}.", "",
+              "| model | Bingham Mn* | Bingham tau_y / (phi mu0 M^2) | chi2/dof | power-law Mn* | Delta | chi2/dof | "
+              "note |", "|---|---:|---:|---:|---:|---:|---:|---|"]
     for k in models:
         b, pw = crit["models"][k]["bingham"], crit["models"][k]["power_law"]
         note = "" if pw["ok"] else pw.get("message", "")
-        lines.append(f"| {k} | {b['mason_star']:.3g} ± {b['mason_star_err']:.2g} | "
-                     f"{pw['mason_star']:.3g} ± {pw['mason_star_err']:.2g} | {pw['exponent']:.2f} ± "
-                     f"{pw['exponent_err']:.2f} | {pw['chi2_dof']:.2g} | {note} |")
+        ty = b["eta_inf"] * b["mason_star"] / (4.5 * phi)
+        ty_err = ty * math.hypot(b["eta_inf_err"] / b["eta_inf"], b["mason_star_err"] / b["mason_star"])
+        lines.append(f"| {k} | {b['mason_star']:.3g} ± {b['mason_star_err']:.2g} | {ty:.4f} ± {ty_err:.4f} | "
+                     f"{b['chi2_dof']:.2g} | {pw['mason_star']:.3g} ± {pw['mason_star_err']:.2g} | "
+                     f"{pw['exponent']:.2f} ± {pw['exponent_err']:.2f} | {pw['chi2_dof']:.2g} | {note} |")
+    lines.append("")
     small_crit_path = arg(argv, "--small-criterion", os.path.join(here, "study", "criterion_default.json"))
     small_crit = json.load(open(small_crit_path)) if os.path.exists(small_crit_path) else None
     lines += old_claims(crit, small_crit, phi, small_m)
