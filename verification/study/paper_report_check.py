@@ -1,0 +1,121 @@
+#!/usr/bin/python3
+"""The paper-scale report's derived numbers against a flow curve whose answers
+are known in closed form: `mrf criterion` and reports/paper_study.py run on a
+synthetic sweep of exact Bingham fluids on the realistic path (one shear rate,
+M from Mn), and the report must give back each model's yield stress, the
+low-Mn slopes and the verdicts on the small-cell claims.
+
+Model k: tau = c_k phi mu0 M^2 + e_k eta gdot, so tau_y / (phi mu0 M^2) = c_k
+(the Bingham yield stress scales with M^2), eta_r = e_k + 4.5 phi c_k / Mn
+(Mn* = 4.5 phi c_k / e_k), and the normalised total stress is
+t(Mn) = c_k + e_k Mn / (4.5 phi). Its fluid part is e_k eta gdot, so the
+particle part is flat in Mn: slope 0.
+
+usage: paper_report_check.py MRF_BINARY REPO_ROOT WORK_DIR
+"""
+import csv
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+MU0 = 4e-7 * math.pi
+ETA, GDOT, PHI = 0.1, 1e3, 0.30
+GRID = [1e-3, 1e-2, 0.1, 1.0, 10.0]
+# (yield c_k in phi mu0 M^2, high-rate relative viscosity e_k)
+MODELS = {"dem_stokes": (0.006, 1.0), "demsph_stokes": (0.011, 1.25), "demsph_dd": (0.012, 1.3)}
+COLUMNS = ["model", "mason", "seed", "status", "shear_rate", "strain", "warmup_strain", "stress_total",
+           "stress_total_err", "stress_total_drift_z", "steady_mser_discard_fraction", "stress_fluid",
+           "stress_virial_total", "n_particles", "wall_seconds", "stokes_number", "reynolds_number", "magnetization",
+           "volume_fraction", "viscosity", "fluid_density", "gap", "radius"]
+
+
+def total(k, mn):
+    c, e = MODELS[k]
+    return c + e * mn / (4.5 * PHI)  # tau / (phi mu0 M^2)
+
+
+def main(argv):
+    mrf, root, work = argv[1], argv[2], argv[3]
+    shutil.rmtree(work, ignore_errors=True)
+    sweep = os.path.join(work, "sweep")
+    os.makedirs(sweep)
+    with open(os.path.join(sweep, "sweep.csv"), "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(COLUMNS)
+        for k, (c, e) in MODELS.items():
+            for mn in GRID:
+                m = math.sqrt(9 * ETA * GDOT / (2 * MU0 * mn))
+                scale = PHI * MU0 * m * m
+                tau = total(k, mn) * scale
+                for seed in (1, 2, 3):
+                    # the same stress for every seed (no scatter), 0.5 % within-run error
+                    w.writerow([k, mn, seed, "ok", GDOT, 30, 8, repr(tau), repr(0.005 * tau), 0.1, 0.0,
+                                repr(e * ETA * GDOT), repr(tau), 4125, 100.0, 1e-4, 6e-5, repr(m), PHI, ETA, 1000.0,
+                                1.5e-4, 2.5e-6])
+    subprocess.run([mrf, "criterion", sweep], check=True, stdout=subprocess.DEVNULL)
+    out = os.path.join(work, "report")
+    none = os.path.join(work, "absent")
+    # the report draws with matplotlib: the interpreter running this check, or
+    # the system one the report scripts name (scripts/install-deps installs it there)
+    py = sys.executable
+    if subprocess.run([py, "-c", "import matplotlib"], capture_output=True).returncode != 0:
+        py = "/usr/bin/python3"
+    subprocess.run([py, os.path.join(root, "reports", "paper_study.py"), sweep, out,
+                    "--small", none, "--quasistatic", none, "--fixed-m", none, "--first-runs", none,
+                    "--small-criterion", os.path.join(sweep, "criterion.json")], check=True, stdout=subprocess.DEVNULL)
+    md = open(os.path.join(out, "paper.md")).read()
+    failures = []
+
+    def check(what, got, want, tol):
+        if not abs(got - want) <= tol:
+            failures.append(f"{what}: got {got}, want {want} (tolerance {tol})")
+
+    value = re.compile(r"([-+]?[0-9.]+(?:e[-+]?[0-9]+)?)")
+    for k, (c, e) in MODELS.items():
+        # the Bingham fit's yield stress: c_k; its Mn*: 4.5 phi c_k / e_k
+        fits = [line for line in md.split("## Flow-curve fits")[1].splitlines() if line.startswith(f"| {k} |")]
+        if not fits:
+            failures.append(f"no flow-fit row for {k}")
+            continue
+        cells = [x.strip() for x in fits[0].strip("|").split("|")]
+        check(f"{k} Bingham tau_y / (phi mu0 M^2)", float(value.match(cells[2]).group(1)), c, 0.002 * c + 5e-5)
+        check(f"{k} Bingham Mn*", float(value.match(cells[1]).group(1)), 4.5 * PHI * c / e, 0.01 * 4.5 * PHI * c / e)
+        # low-Mn slopes (paper cell row): total analytic, particle part 0
+        slope = [line for line in md.splitlines() if line.startswith(f"| {k} | paper | ")]
+        if not slope:
+            failures.append(f"no slope row for {k}")
+            continue
+        cells = [x.strip() for x in slope[0].strip("|").split("|")]
+        want = math.log(total(k, 1e-2) / total(k, 1e-3)) / math.log(10.0)
+        check(f"{k} slope of the total", float(value.match(cells[3]).group(1)), want, 0.006)
+        check(f"{k} slope of the particle part", float(value.match(cells[4]).group(1)), 0.0, 0.006)
+        if cells[6] != "yes":
+            failures.append(f"{k}: a flat particle part not called flat ({cells[6]})")
+    # The verdict on "model 1 is 27-68 % below model 3": D_1 at each Mn from
+    # the closed form, against the report's yes/no.
+    claims = [line for line in md.splitlines() if line.startswith("| model 1 is 27-68 %")]
+    if len(claims) != len(GRID):
+        failures.append(f"{len(claims)} rows for the model-1 claim, want {len(GRID)}")
+    for line in claims:
+        cells = [x.strip() for x in line.strip("|").split("|")]
+        mn = float(cells[1])
+        d = total("dem_stokes", mn) / total("demsph_dd", mn) - 1
+        check(f"D_1 at Mn {mn:g}", float(value.match(cells[3]).group(1)), d, 0.0015)
+        want = "yes" if -0.68 - 0.02 <= d <= -0.27 + 0.02 else "**no**"
+        if abs(d + 0.27) > 0.03 and abs(d + 0.68) > 0.03 and cells[4] != want:
+            failures.append(f"claim verdict at Mn {mn:g}: D_1 = {d:+.3f}, report says {cells[4]}, want {want}")
+    # sanity of the design: the claim must hold at some Mn and fail at another
+    verdicts = {line.split("|")[-2].strip() for line in claims}
+    if verdicts != {"yes", "**no**"}:
+        failures.append(f"the synthetic design should give both verdicts, got {verdicts}")
+    for f in failures:
+        print("FAIL:", f)
+    print(f"paper report check: {len(failures)} failure(s)")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
