@@ -5,7 +5,7 @@
 //             [--cutoff R] [--no-affine] [--minimiser fire|lbfgs] [--lbfgs-memory M] [--resume]
 //             [--branch-from CHECKPOINT] [--start-from FRAMES] [--checkpoint-every S]
 //   mrf sweep SWEEP.toml [--out DIR] [--quiet] [--estimate | --list | --collect] [--point K | --rank R --ranks K]
-//             [--checkpoint-every S] [--archive DIR]   (mpirun -n K: master-worker schedule)
+//             [--checkpoint-every S] [--archive DIR] [--calibrate-from DIR]   (mpirun -n K: master-worker schedule)
 // Exit status: 0 done, 2 bad input, 3 numerical failure or refused
 // checkpoint, 4 a sweep point failed, 5 output could not be written, 1 other.
 #include <CLI/CLI.hpp>
@@ -63,7 +63,7 @@ namespace {
 #endif
 
 struct SweepArgs {
-  std::string file, out, archive;
+  std::string file, out, archive, calibrate;
   bool quiet = false, estimate = false, list = false, collect = false, no_csv = false;
   int rank = 0, ranks = 0;
   long point = -1;
@@ -89,6 +89,9 @@ int sweep_command(const SweepArgs& a) {
     throw mrf::InputError("--checkpoint-every", std::to_string(a.checkpoint_seconds), "", "must be >= 0 (0 = none)");
   opt.checkpoint_seconds = a.checkpoint_seconds;
   opt.archive = a.archive;
+  opt.calibrate = a.calibrate;
+  if (!a.calibrate.empty() && !std::filesystem::is_directory(a.calibrate))
+    throw mrf::InputError("--calibrate-from", a.calibrate, "", "is not a folder (of finished points' summary.json)");
   opt.write_csv = !a.no_csv;
   if (!a.archive.empty() && (a.collect || a.list || a.estimate))  // a run restores its own share (run_sweep)
     mrf::report_archive(mrf::restore_from_archive(spec, mrf::sweep_points(spec), out, a.archive), a.archive, a.quiet);
@@ -102,7 +105,7 @@ int sweep_command(const SweepArgs& a) {
     // index, folder, state and estimate of every point: what a job array or
     // GNU parallel needs to hand `--point K` out
     const auto points = mrf::sweep_points(spec);
-    const mrf::PointEstimates est = mrf::estimate_points(spec, points, out, opt.cost_rate, a.archive);
+    const mrf::PointEstimates est = mrf::estimate_points(spec, points, out, opt.cost_rate, a.archive, a.calibrate);
     std::printf("%-5s %-40s %-14s %-9s %-5s %-9s %s\n", "point", "folder", "model", "Mn", "seed", "state",
                 "estimate (s; * = from the particle-steps model, no point of the model finished)");
     for (const auto& p : points) {
@@ -119,7 +122,7 @@ int sweep_command(const SweepArgs& a) {
   }
   if (a.estimate) {
     const auto points = mrf::sweep_points(spec);
-    const mrf::PointEstimates est = mrf::estimate_points(spec, points, out, opt.cost_rate, a.archive);
+    const mrf::PointEstimates est = mrf::estimate_points(spec, points, out, opt.cost_rate, a.archive, a.calibrate);
     double total = 0;
     std::size_t model_only = 0;
     for (const auto& p : points) {
@@ -129,9 +132,11 @@ int sweep_command(const SweepArgs& a) {
       model_only += est.calibrated[p.index] ? 0 : 1;
     }
     std::printf("total %.3g s (%.3g h) on one core; %zu points (*) from the particle-steps model at %.3g "
-                "particle-steps/s, the rest from the finished points in %s%s\n",
+                "particle-steps/s (blind to the implicit schemes' error-controlled steps: a lower bound), the rest "
+                "from the finished points in %s%s%s\n",
                 total, total / 3600, model_only, opt.cost_rate, out.c_str(),
-                a.archive.empty() ? "" : (" and " + a.archive).c_str());
+                a.archive.empty() ? "" : (" and " + a.archive).c_str(),
+                a.calibrate.empty() ? "" : (" and, for the cost alone, " + a.calibrate).c_str());
     return 0;
   }
 #ifdef MRF_HAVE_MPI
@@ -190,6 +195,9 @@ int main(int argc, char** argv) {
   sw->add_option("--archive", sa.archive,
                  "folder of finished points' summary.json (committed): restored into --out first, added to as points "
                  "finish; an entry of an edited scene is ignored");
+  sw->add_option("--calibrate-from", sa.calibrate,
+                 "folder laid out like an archive whose summaries calibrate the cost estimates only (nothing is "
+                 "restored from it): an estimate for a fresh run from the measured cost of an earlier one");
   sw->add_flag("--no-csv", sa.no_csv, "do not rewrite sweep.csv at the end (concurrent --point runs: --collect once)");
   sw->add_option("--point", sa.point, "run point K of the grid alone (0-based, as --list numbers them)");
   sw->add_option("--checkpoint-every", sa.checkpoint_seconds, "wall seconds between a point's checkpoints (0 = none)")

@@ -183,6 +183,15 @@ TEST(Sweep, KilledSweepResumesAndReproduces) {
   const PointEstimates archived = estimate_points(wider, pts, (out / "nothing_here").string(), 1e6, out.string());
   EXPECT_TRUE(archived.calibrated[1] && archived.calibrated[2]);
   EXPECT_DOUBLE_EQ(archived.seconds[1], read_json(p1 / "summary.json")["seconds_per_strain"].get<double>() * 0.6);
+  // --calibrate-from: the same folder read for the cost alone (a fresh run
+  // estimated from an earlier one's measured cost) gives the same estimates,
+  // and restores nothing.
+  const PointEstimates calibrated =
+      estimate_points(wider, pts, (out / "nothing_here").string(), 1e6, "", out.string());
+  EXPECT_TRUE(calibrated.calibrated[1] && calibrated.calibrated[2]);
+  EXPECT_DOUBLE_EQ(calibrated.seconds[1], archived.seconds[1]);
+  EXPECT_DOUBLE_EQ(calibrated.seconds[2], archived.seconds[2]);
+  EXPECT_FALSE(std::filesystem::exists(out / "nothing_here"));
 
   // `--point K` (what a job array hands out) runs point K alone, into the
   // same folder with the same result; a K outside the grid is refused.

@@ -85,7 +85,7 @@ int mpi_sweep(const mrf::SweepSpec& spec, const std::string& out, const mrf::Swe
   if (rank == 0) {
     if (!opt.archive.empty())
       mrf::report_archive(mrf::restore_from_archive(spec, points, out, opt.archive), opt.archive, opt.quiet);
-    const mrf::PointEstimates est = mrf::estimate_points(spec, points, out, opt.cost_rate, opt.archive);
+    const mrf::PointEstimates est = mrf::estimate_points(spec, points, out, opt.cost_rate, opt.archive, opt.calibrate);
     std::vector<long> order;
     for (const auto& p : points)
       if (!mrf::point_finished((std::filesystem::path(out) / p.dir).string())) order.push_back(static_cast<long>(p.index));

@@ -84,7 +84,7 @@ double estimate_point_seconds(const std::string& scene_path, const std::vector<s
 }
 
 PointEstimates estimate_points(const SweepSpec& spec, const std::vector<SweepPoint>& points, const std::string& out_dir,
-                               double cost_rate, const std::string& archive_dir) {
+                               double cost_rate, const std::string& archive_dir, const std::string& calibrate_dir) {
   struct Measured {
     std::string model;
     double log_mn, per_strain, wall;
@@ -93,11 +93,19 @@ PointEstimates estimate_points(const SweepSpec& spec, const std::vector<SweepPoi
   for (std::size_t k = 0; k < points.size(); ++k) {
     // A point finished under out_dir is its own estimate; one only in the
     // archive (a --point run restores no other point, and an archived entry
-    // of an edited scene is re-run) calibrates by its seconds per strain unit.
+    // of an edited scene is re-run) or in the calibration folder calibrates
+    // by its seconds per strain unit.
     auto path = std::filesystem::path(out_dir) / points[k].dir / "summary.json";
     const bool own = std::filesystem::exists(path);
-    if (!own) path = std::filesystem::path(archive_dir) / points[k].dir / "summary.json";
-    if (!own && (archive_dir.empty() || !std::filesystem::exists(path))) continue;
+    if (!own) {
+      bool found = false;
+      for (const std::string* d : {&archive_dir, &calibrate_dir})
+        if (!found && !d->empty() && std::filesystem::exists(std::filesystem::path(*d) / points[k].dir / "summary.json")) {
+          path = std::filesystem::path(*d) / points[k].dir / "summary.json";
+          found = true;
+        }
+      if (!found) continue;
+    }
     try {
       std::ifstream in(path);
       const nlohmann::json j = nlohmann::json::parse(in);
@@ -153,7 +161,7 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
     for (std::size_t i : mine) share.push_back(points[i]);
     report_archive(restore_from_archive(spec, share, out_dir, opt.archive), opt.archive, opt.quiet);
   }
-  const PointEstimates calibrated = estimate_points(spec, points, out_dir, opt.cost_rate, opt.archive);
+  const PointEstimates calibrated = estimate_points(spec, points, out_dir, opt.cost_rate, opt.archive, opt.calibrate);
   for (std::size_t i : mine) {
     const SweepPoint& p = points[i];
     if (point_finished((std::filesystem::path(out_dir) / p.dir).string())) {
