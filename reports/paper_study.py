@@ -360,6 +360,24 @@ def main(argv):
               "(the sweep ran at nice 19 beside other work: an upper bound, not a benchmark; "
               "reports/performance/model_ratios.md has the side-by-side ratios).", ""]
     lines += sweep_cost(rows, first_dir)
+    # cost per strain unit per model and Mn: the fastest seed (the least
+    # disturbed by other jobs), and its ratio to model 1's at the same Mn
+    per = defaultdict(list)
+    for r in rows:
+        per[(r["model"], float(r["mason"]))].append(num(r, "wall_seconds") / num(r, "strain"))
+    lines += ["Cost per strain unit: the fastest seed's wall seconds on one thread (the work; a run's wall time also "
+              "holds the time its machine gave to other jobs, and some runs were paused while benchmarks ran, so seeds "
+              "of the same steps and iterations can differ several times in wall time: an upper bound, and the "
+              "ratios are rough), in brackets the ratio to model 1's at the same Mn:", "",
+              "| model | " + " | ".join(f"Mn {m:g}" for m in grid) + " |", "|---|" + "---:|" * len(grid)]
+    for k in models:
+        cells = []
+        for m in grid:
+            v = min(per[(k, m)]) if per.get((k, m)) else float("nan")
+            v1 = min(per[("dem_stokes", m)]) if per.get(("dem_stokes", m)) else float("nan")
+            cells.append("–" if v != v else f"{v:.3g}" + ("" if k == "dem_stokes" or v1 != v1 else f" ({v / v1:.1f}x)"))
+        lines.append(f"| {k} | " + " | ".join(cells) + " |")
+    lines.append("")
     # ---- wall against volume stress: what the imposed flow of model 1 absorbs --
     lines += ["## Wall and volume-side stress per model", "",
               "Seed means over φμ0M²; volume side = the particle pair virial plus the carrier's part (model 1: "
