@@ -105,6 +105,7 @@ const KeySpec k_keys[] = {
     {"numerics.dt_safety", &C::dt_safety, Dim::none, Need::optional, {0, 1, true, false}},
     {"numerics.implicit_tol", &C::implicit_tol, Dim::none, Need::optional, {0, 1, true, false}},
     {"numerics.implicit_order", &C::implicit_order, Dim::none, Need::optional, k_any},
+    {"numerics.newton_tol", &C::newton_tol, Dim::none, Need::optional, {0, 1e-2, true, false}},
     {"numerics.threads", &C::threads, Dim::none, Need::optional, k_any},
     {"output.every", &C::every, Dim::none, Need::optional, k_any},
     {"output.frames", &C::frames, Dim::none, Need::optional, k_any},

@@ -139,6 +139,7 @@ CoupledTimeStep choose_coupled_time_step(const LoadedScene& scene, const DemPara
     s.dt_fluid = c.dt_safety * bf.dt;
     s.sph_skin = k_sph_skin_over_h * fluid.h;
     s.implicit.tol_over_radius = c.implicit_tol;
+    s.implicit.newton_tol_over_radius = c.newton_tol;
     s.implicit.order = c.implicit_order;
     return t;
   }
@@ -185,6 +186,7 @@ BuiltModel build_dem(const LoadedScene& scene, ShearCell cell, const DemParams& 
   auto model = std::make_unique<DemModel>(std::move(cell), p, ts.scheme, ts.dt);
   ImplicitOptions o;
   o.tol_over_radius = c.implicit_tol;
+  o.newton_tol_over_radius = c.newton_tol;
   o.order = c.implicit_order;
   if (ts.scheme == IntegratorId::implicit) model->set_implicit_options(o);
   b.model = std::move(model);

@@ -232,6 +232,12 @@ std::string scene_fingerprint(const SceneConfig& c) {
   }
   out += std::string(to_string(c.model)) + ";" + to_string(c.integrator) + ";" + std::to_string(c.seed) + ";" +
          std::to_string(c.threads) + ";" + std::to_string(c.implicit_order) + ";" + std::to_string(c.every) + ";" + std::to_string(c.frames);
+  // added after points were archived: only a value other than the default
+  // enters, so that the scene_id of every earlier scene stays what it was
+  if (c.newton_tol != SceneConfig{}.newton_tol) {
+    std::snprintf(buf, sizeof buf, ";newton_tol %a", c.newton_tol);
+    out += buf;
+  }
   return out;
 }
 

@@ -66,6 +66,7 @@ struct SceneConfig {
   double dt_safety = 0.5;      // fraction of the smallest stability limit used by automatic dt
   double implicit_tol = 1e-2;  // implicit scheme: largest local error per step / radius
   int implicit_order = 2;      // implicit scheme: 1 (IMEX Euler) or 2 (IMEX BDF2)
+  double newton_tol = 1e-6;    // implicit scheme: Newton converged when every overlap residual / radius is below it
   int threads = 1;             // OpenMP threads; 0 = the OpenMP default (all cores or OMP_NUM_THREADS)
   // [output]
   int every = 0;               // steps between time-series rows; 0 = about 2000 rows per run
