@@ -80,6 +80,28 @@ TEST(ImplicitRun, ShortRunReportsCountsAndBoundedSteps) {
   EXPECT_LT(r.max_overlap_over_radius * p.radius, hertz_overlap_under_load(p.expected_load, p.hertz_k));
 }
 
+// numerics.newton_tol reaches the contact Newton solves: a tighter stopping
+// residual takes more Newton iterations per step (reports/study/newton_tol.md
+// measures the stress it moves: none beyond its error), for model 1 and the
+// inertialess coupled scheme.
+TEST(ImplicitRun, NewtonToleranceReachesTheSolves) {
+  for (const char* model : {"scene.model=dem_stokes", "scene.model=demsph_dd"}) {
+    double per_step[2];
+    int k = 0;
+    for (const char* tol : {"numerics.newton_tol=1e-4", "numerics.newton_tol=1e-8"}) {
+      const RunSummary r = run_scene(small({model, tol, "drive.strain=0.6", "drive.warmup_strain=0.1",
+                                            "drive.vary='magnetization'", "drive.shear_rate=1e3",
+                                            "contact.youngs_modulus='200 GPa'", "drive.mason=0.01"}),
+                                     RunOptions{"", true});
+      ASSERT_NE(r.integrator.find("implicit"), std::string::npos) << model << " " << r.integrator;
+      per_step[k++] = r.extra.at("implicit_newton_iterations") / static_cast<double>(r.steps);
+    }
+    std::printf("%s: Newton iterations per step %.2f (1e-4 R) against %.2f (1e-8 R)\n", model, per_step[0],
+                per_step[1]);
+    EXPECT_LT(per_step[0] + 1.0, per_step[1]) << model;
+  }
+}
+
 // A short run: the error-controlled step is bounded by the averaging
 // window (at least 64 steps in it), so the run writes its rows instead of
 // being refused; with output.every set too large, that key and its line are

@@ -183,6 +183,7 @@ TEST(SceneInput, OptionalKeysTakeTheirDefaults) {
   EXPECT_EQ(c.dt_safety, 0.5);
   EXPECT_EQ(c.implicit_tol, 1e-2);
   EXPECT_EQ(c.implicit_order, 2);
+  EXPECT_EQ(c.newton_tol, 1e-6);
   EXPECT_EQ(c.sound_speed, 0.0);
   EXPECT_EQ(c.threads, 1);
   EXPECT_EQ(c.every, 0);
@@ -344,6 +345,7 @@ const Bad k_bad[] = {
      "expected one of: auto, verlet_exp, overdamped, implicit"},
     {"ImplicitTolAboveOne", "skin =", "implicit_tol = 2", "numerics.implicit_tol", "2", "must be in (0, 1]"},
     {"ImplicitOrderThree", "skin =", "implicit_order = 3", "numerics.implicit_order", "3", "must be 1 or 2"},
+    {"NewtonTolAboveOnePercent", "skin =", "newton_tol = 0.1", "numerics.newton_tol", "0.1", "must be in (0, 0.01]"},
     {"BadModel", "model =", "model = \"dem\"", "scene.model", "\"dem\"",
      "expected one of: dem_stokes, demsph_stokes, demsph_dd"},
     {"CutoffBeyondMinimumImage", "dipole_cutoff =", "dipole_cutoff = \"25 um\"",
