@@ -93,6 +93,8 @@ int sweep_command(const SweepArgs& a) {
   if (!a.calibrate.empty() && !std::filesystem::is_directory(a.calibrate))
     throw mrf::InputError("--calibrate-from", a.calibrate, "", "is not a folder (of finished points' summary.json)");
   opt.write_csv = !a.no_csv;
+  if (a.collect || a.list || a.estimate)  // a run sets aside its own share (run_sweep)
+    mrf::set_aside_stale(spec, mrf::sweep_points(spec), out, a.quiet);
   if (!a.archive.empty() && (a.collect || a.list || a.estimate))  // a run restores its own share (run_sweep)
     mrf::report_archive(mrf::restore_from_archive(spec, mrf::sweep_points(spec), out, a.archive), a.archive, a.quiet);
   if (a.collect) {  // sweep.csv from the finished points, nothing run (while other ranks still work)

@@ -94,5 +94,34 @@ TEST(SweepArchive, FinishedPointsSurviveTheLossOfTheOutputAndStaleEntriesRunAgai
   std::filesystem::remove_all(root);
 }
 
+// The same rule for the output folder (no archive): after an edit of the
+// sweep file, a finished point's folder holds a run of another scene; the
+// sweep moves it to <folder>.stale and runs the point again, and --collect
+// never lists the old run as the point's.
+TEST(SweepArchive, AFinishedRunOfAnotherSceneInTheOutputRunsAgain) {
+  const auto root = std::filesystem::temp_directory_path() / "mrf_test_sweep_stale_output";
+  std::filesystem::remove_all(root);
+  const std::string out = (root / "out").string();
+  SweepOptions opt;
+  opt.quiet = true;
+  const SweepSpec s = tiny("0.6");
+  ASSERT_EQ(run_sweep(s, out, opt).ran, 2u);
+  EXPECT_EQ(run_sweep(s, out, opt).ran, 0u);  // unchanged: nothing runs, nothing moves
+  const auto pts = sweep_points(s);
+  EXPECT_FALSE(std::filesystem::exists(root / "out" / (pts[0].dir + ".stale")));
+  const std::string old0 = slurp(root / "out" / pts[0].dir / "summary.json");
+
+  const SweepSpec edited = tiny("0.8");
+  const auto moved = set_aside_stale(edited, sweep_points(edited), out, true);  // what --collect does first
+  EXPECT_EQ(moved.size(), 2u);
+  EXPECT_EQ(slurp(root / "out" / (pts[0].dir + ".stale") / "summary.json"), old0);
+  EXPECT_EQ(write_sweep_csv(sweep_points(edited), out), 0u);  // no point of the edited sweep is finished
+  const SweepOutcome again = run_sweep(edited, out, opt);
+  EXPECT_EQ(again.ran, 2u);
+  EXPECT_EQ(nlohmann::json::parse(slurp(root / "out" / pts[0].dir / "summary.json"))["strain"], 0.8);
+  EXPECT_TRUE(set_aside_stale(edited, sweep_points(edited), out, true).empty());
+  std::filesystem::remove_all(root);
+}
+
 }  // namespace
 }  // namespace mrf

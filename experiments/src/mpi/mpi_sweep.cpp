@@ -83,6 +83,7 @@ int mpi_sweep(const mrf::SweepSpec& spec, const std::string& out, const mrf::Swe
   const auto points = mrf::sweep_points(spec);
   int status = 0;
   if (rank == 0) {
+    mrf::set_aside_stale(spec, points, out, opt.quiet);
     if (!opt.archive.empty())
       mrf::report_archive(mrf::restore_from_archive(spec, points, out, opt.archive), opt.archive, opt.quiet);
     const mrf::PointEstimates est = mrf::estimate_points(spec, points, out, opt.cost_rate, opt.archive, opt.calibrate);

@@ -156,11 +156,11 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
     double estimate;
   };
   std::vector<Todo> todo;
-  if (!opt.archive.empty()) {
-    std::vector<SweepPoint> share;
-    for (std::size_t i : mine) share.push_back(points[i]);
+  std::vector<SweepPoint> share;
+  for (std::size_t i : mine) share.push_back(points[i]);
+  set_aside_stale(spec, share, out_dir, opt.quiet);
+  if (!opt.archive.empty())
     report_archive(restore_from_archive(spec, share, out_dir, opt.archive), opt.archive, opt.quiet);
-  }
   const PointEstimates calibrated = estimate_points(spec, points, out_dir, opt.cost_rate, opt.archive, opt.calibrate);
   for (std::size_t i : mine) {
     const SweepPoint& p = points[i];

@@ -1,5 +1,6 @@
 // The sweep archive: finished points' summary.json files kept apart from the
 // sweep output, keyed by the scene_id of the scene that produced them.
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -44,6 +45,33 @@ ArchiveSync restore_from_archive(const SweepSpec& spec, const std::vector<SweepP
     ++sync.restored;
   }
   return sync;
+}
+
+std::vector<std::string> set_aside_stale(const SweepSpec& spec, const std::vector<SweepPoint>& points,
+                                         const std::string& out_dir, bool quiet) {
+  std::vector<std::string> moved;
+  for (const SweepPoint& p : points) {
+    const auto dir = std::filesystem::path(out_dir) / p.dir;
+    const auto summary = dir / "summary.json";
+    if (!std::filesystem::exists(summary)) continue;
+    const nlohmann::json j = nlohmann::json::parse(read_text(summary), nullptr, false);
+    if (j.is_discarded() || !j.contains("scene_id") || !j["scene_id"].is_string()) continue;
+    if (j["scene_id"].get<std::string>() == scene_id(load_scene(spec.scene_path, p.sets).config)) continue;
+    const auto aside = std::filesystem::path(dir.string() + ".stale");
+    std::error_code ec;
+    std::filesystem::remove_all(aside, ec);
+    std::filesystem::rename(dir, aside, ec);
+    if (ec) {
+      if (!std::filesystem::exists(dir)) continue;  // another process moved it first
+      throw OutputError(dir.string() + ": cannot move a run of another scene aside to " + aside.string() + ": " +
+                        ec.message());
+    }
+    moved.push_back(p.dir);
+    if (!quiet)
+      std::fprintf(stderr, "mrf sweep: %s holds a run of another scene (scene_id differs): moved to %s; the point "
+                           "runs again\n", dir.string().c_str(), aside.string().c_str());
+  }
+  return moved;
 }
 
 void archive_point(const SweepPoint& p, const std::string& out_dir, const std::string& archive_dir) {
