@@ -1,0 +1,96 @@
+#!/usr/bin/python3
+"""The paper-scale report while its steadiness re-runs are still running.
+
+experiments/sweeps/paper_realistic.toml holds re-run rules (strain and
+warm-up doubled) for the points whose first run failed a steadiness test.
+Until a re-run has finished, its point's archive entry is the first run,
+which the full sweep file calls stale. This builds a temporary sweep file
+with only the re-run rules whose points have all finished at the rule's
+strain (the others' points then read as their first runs), collects it from
+the archive, runs `mrf criterion`, copies sweep.csv and criterion.json into
+reports/study/paper/ and writes the report with --note NOTE. The fixed-M
+path's tables are refreshed from reports/study/paper/fixed_m_points the same
+way (a point whose re-run is pending reads as its first run there too).
+
+usage: scripts/paper_interim.py [--mrf build/mrf] [--note TEXT]
+"""
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+GRID = [1e-3, 1e-2, 0.1, 1.0, 10.0]
+
+
+def arg(key, default):
+    return sys.argv[sys.argv.index(key) + 1] if key in sys.argv else default
+
+
+def interim_toml(src_path, archive, out_path):
+    src = open(src_path).read()
+    head, *rules = src.split("[[rule]]")
+    rerun_start = src.index("# Re-runs for steadiness")
+    keep, pos, pending = [], len(head), []
+    for r in rules:
+        start = pos
+        pos += len("[[rule]]") + len(r)
+        if start < rerun_start:  # the strain rules of the design, not re-runs
+            keep.append(r)
+            continue
+        models = re.findall(r'"(\w+)"', re.search(r"models\s*=\s*\[(.*?)\]", r).group(1))
+        lo = float(re.search(r"mason_min\s*=\s*([\d.e+-]+)", r).group(1))
+        hi = float(re.search(r"mason_max\s*=\s*([\d.e+-]+)", r).group(1))
+        seeds = [int(x) for x in re.search(r"seeds\s*=\s*\[(.*?)\]", r).group(1).split(",")]
+        strain = float(re.search(r"drive\.strain=([\d.]+)", r).group(1))
+        done = True
+        for m in models:
+            for mn in [g for g in GRID if lo <= g <= hi]:
+                for sd in seeds:
+                    f = os.path.join(archive, m, f"mn_{mn:g}_seed_{sd}", "summary.json")
+                    if not os.path.exists(f) or json.load(open(f))["strain"] != strain:
+                        done = False
+                        pending.append(f"{m} Mn {mn:g} seed {sd}")
+        if done:
+            keep.append(r)
+    with open(out_path, "w") as fh:
+        fh.write(head + "".join("[[rule]]" + r for r in keep))
+    return pending
+
+
+def collect(mrf, toml, out, archive):
+    shutil.rmtree(out, ignore_errors=True)  # a clean collect: the archive is the record
+    subprocess.run([mrf, "sweep", toml, "--out", out, "--archive", archive, "--collect", "--quiet"], check=True)
+    subprocess.run([mrf, "criterion", out], check=True, stdout=subprocess.DEVNULL)
+
+
+def main():
+    os.chdir(ROOT)
+    mrf = arg("--mrf", "build/mrf")
+    paper = "reports/study/paper"
+    sweeps = "experiments/sweeps"
+    tmp = os.path.join(sweeps, "_paper_interim.toml")  # beside the others: the scene path is relative
+    try:
+        for name, archive, csv_name, crit_name in (
+                ("paper_realistic", f"{paper}/points", "sweep.csv", "criterion.json"),
+                ("paper_fixed_m", f"{paper}/fixed_m_points", "fixed_m_sweep.csv", "fixed_m_criterion.json")):
+            pending = interim_toml(os.path.join(sweeps, name + ".toml"), archive, tmp)
+            print(f"{name}: re-runs pending: {', '.join(pending) if pending else 'none'}")
+            out = os.path.join("out", "sweeps", name + "_interim")
+            collect(mrf, tmp, out, archive)
+            shutil.copy(os.path.join(out, "sweep.csv"), os.path.join(paper, csv_name))
+            shutil.copy(os.path.join(out, "criterion.json"), os.path.join(paper, crit_name))
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+    cmd = ["/usr/bin/python3", "reports/paper_study.py", "out/sweeps/paper_realistic_interim", paper]
+    if "--note" in sys.argv:
+        cmd += ["--note", arg("--note", "")]
+    subprocess.run(cmd, check=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
