@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "mrf/io/toml_scene.hpp"
+#include "mrf/scene/run.hpp"
 #include "mrf/scene/run_series.hpp"
 #include "mrf/study/sweep.hpp"
 
@@ -120,6 +121,23 @@ TEST(SweepArchive, AFinishedRunOfAnotherSceneInTheOutputRunsAgain) {
   EXPECT_EQ(again.ran, 2u);
   EXPECT_EQ(nlohmann::json::parse(slurp(root / "out" / pts[0].dir / "summary.json"))["strain"], 0.8);
   EXPECT_TRUE(set_aside_stale(edited, sweep_points(edited), out, true).empty());
+
+  // An unfinished run (a checkpoint, no summary) of the old scene: resuming
+  // it would be refused, so it is set aside too; one of the current scene is
+  // left to resume.
+  const auto pe = sweep_points(edited);
+  std::filesystem::remove_all(root / "out" / pe[0].dir);
+  RunOptions cut;
+  cut.out_dir = (root / "out" / pe[0].dir).string();
+  cut.quiet = true;
+  cut.checkpoint_every_rows = 5;
+  cut.stop_after_steps = 40;
+  EXPECT_THROW(run_scene(load_scene(s.scene_path, sweep_points(s)[0].sets), cut), RunInterrupted);  // the old scene
+  ASSERT_TRUE(std::filesystem::exists(root / "out" / pe[0].dir / "checkpoint.bin"));
+  EXPECT_EQ(set_aside_stale(edited, pe, out, true), std::vector<std::string>{pe[0].dir});
+  EXPECT_THROW(run_scene(load_scene(edited.scene_path, pe[0].sets), cut), RunInterrupted);  // the current one
+  ASSERT_TRUE(std::filesystem::exists(root / "out" / pe[0].dir / "checkpoint.bin"));
+  EXPECT_TRUE(set_aside_stale(edited, pe, out, true).empty());
   std::filesystem::remove_all(root);
 }
 

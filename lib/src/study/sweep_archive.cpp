@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "mrf/error.hpp"
+#include "mrf/io/archive.hpp"
 #include "mrf/io/atomic_file.hpp"
 #include "mrf/scene/run_series.hpp"
 #include "mrf/io/toml_scene.hpp"
@@ -52,11 +53,23 @@ std::vector<std::string> set_aside_stale(const SweepSpec& spec, const std::vecto
   std::vector<std::string> moved;
   for (const SweepPoint& p : points) {
     const auto dir = std::filesystem::path(out_dir) / p.dir;
-    const auto summary = dir / "summary.json";
-    if (!std::filesystem::exists(summary)) continue;
-    const nlohmann::json j = nlohmann::json::parse(read_text(summary), nullptr, false);
-    if (j.is_discarded() || !j.contains("scene_id") || !j["scene_id"].is_string()) continue;
-    if (j["scene_id"].get<std::string>() == scene_id(load_scene(spec.scene_path, p.sets).config)) continue;
+    const auto summary = dir / "summary.json", checkpoint = dir / "checkpoint.bin";
+    if (std::filesystem::exists(summary)) {  // a finished run
+      const nlohmann::json j = nlohmann::json::parse(read_text(summary), nullptr, false);
+      if (j.is_discarded() || !j.contains("scene_id") || !j["scene_id"].is_string()) continue;
+      if (j["scene_id"].get<std::string>() == scene_id(load_scene(spec.scene_path, p.sets).config)) continue;
+    } else if (std::filesystem::exists(checkpoint)) {  // a run under way, which --resume would refuse
+      try {
+        ArchiveReader in(checkpoint.string());
+        std::string fp;
+        in.get(fp);
+        if (fp == scene_fingerprint(load_scene(spec.scene_path, p.sets).config)) continue;
+      } catch (const NumericalError&) {
+        continue;  // a damaged checkpoint: the run's resume says so
+      }
+    } else {
+      continue;
+    }
     const auto aside = std::filesystem::path(dir.string() + ".stale");
     std::error_code ec;
     std::filesystem::remove_all(aside, ec);

@@ -175,10 +175,11 @@ void report_archive(const ArchiveSync& sync, const std::string& archive_dir, boo
 // The same rule for the sweep output itself: a point folder under out_dir
 // whose summary.json was written for another scene (its scene_id differs
 // from the point's as the sweep file now defines it: a rule, an override or
-// the scene edited since it ran) is moved to <folder>.stale (replacing an
-// earlier one), so that the point runs again and no table reads the old run
-// as this point's. A summary without a scene_id (an older mrf) and a
-// failure.json are left alone. Returns the point folders moved; says so on
+// the scene edited since it ran), or, unfinished, whose checkpoint.bin was
+// (its scene fingerprint differs), is moved to <folder>.stale (replacing an
+// earlier one), so that the point runs again from the start and no table
+// reads the old run as this point's. A summary without a scene_id (an older
+// mrf), a damaged checkpoint and a failure.json are left alone. Returns the point folders moved; says so on
 // stderr unless quiet.
 std::vector<std::string> set_aside_stale(const SweepSpec& spec, const std::vector<SweepPoint>& points,
                                          const std::string& out_dir, bool quiet);
