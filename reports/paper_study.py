@@ -171,6 +171,7 @@ def old_claims(crit, small_crit, phi, small_m):
             lr = math.log(b["mason"] / a["mason"])
             if va <= 0 or vb <= 0:
                 out.append("–")
+                flat = "–"
                 continue
             sl, se = math.log(vb / va) / lr, math.hypot(ea / va, eb / vb) / lr
             out.append(f"{sl:+.2f} ± {se:.2f}")
@@ -455,7 +456,7 @@ def main(argv):
     lines += ["## Flow-curve fits (mrf criterion)", "",
               "eta/eta_inf = 1 + (Mn*/Mn)^Delta fitted to the seed-combined points (Bingham: Delta = 1). The "
               "Bingham fit's dynamic yield stress is tau_y / (phi mu0 M^2) = eta_r,inf Mn* / (4.5 phi) (REFERENCE.md "
-              "§7, Bi = Mn*/Mn), its error from those of eta_r,inf and Mn* in quadrature (their covariance left out); "
+              "§7, Bi = Mn*/Mn), = b/(4.5 phi) with b the fit's coefficient of 1/Mn and its error; "
               "a power law with Delta < 1 has no finite yield stress (tau ~ Mn^(1 - Delta) as Mn -> 0). chi2/dof far "
               "above 1 says that neither form fits within the points' errors (the errors are then inflated by it). "
               f"Beside them: the chain model's {CHAIN_YIELD:g}.", "",
@@ -464,9 +465,14 @@ def main(argv):
     for k in models:
         b, pw = crit["models"][k]["bingham"], crit["models"][k]["power_law"]
         note = "" if pw["ok"] else pw.get("message", "")
-        ty = b["eta_inf"] * b["mason_star"] / (4.5 * phi)
-        ty_err = ty * math.hypot(b["eta_inf_err"] / b["eta_inf"], b["mason_star_err"] / b["mason_star"])
-        lines.append(f"| {k} | {b['mason_star']:.3g} ± {b['mason_star_err']:.2g} | {ty:.4f} ± {ty_err:.4f} | "
+        if b["ok"] and "slope" in b:  # b of eta_r = eta_inf + b/Mn, with its own error (covariance included)
+            yield_ = f"{b['slope'] / (4.5 * phi):.4f} ± {b['slope_err'] / (4.5 * phi):.4f}"
+        elif b["ok"] and b["mason_star"] > 0:  # an older criterion.json: the two errors in quadrature
+            ty = b["eta_inf"] * b["mason_star"] / (4.5 * phi)
+            yield_ = f"{ty:.4f} ± {ty * math.hypot(b['eta_inf_err'] / b['eta_inf'], b['mason_star_err'] / b['mason_star']):.4f}"
+        else:
+            yield_ = "– (" + (b.get("message") or "no fit") + ")"
+        lines.append(f"| {k} | {b['mason_star']:.3g} ± {b['mason_star_err']:.2g} | {yield_} | "
                      f"{b['chi2_dof']:.2g} | {pw['mason_star']:.3g} ± {pw['mason_star_err']:.2g} | "
                      f"{pw['exponent']:.2f} ± {pw['exponent_err']:.2f} | {pw['chi2_dof']:.2g} | {note} |")
     lines.append("")

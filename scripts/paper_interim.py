@@ -40,21 +40,23 @@ def interim_toml(src_path, archive, out_path):
         if start < rerun_start:  # the strain rules of the design, not re-runs
             keep.append(r)
             continue
+        # a re-run rule names its models, Mn range and seeds (paper_realistic.toml's form)
         models = re.findall(r'"(\w+)"', re.search(r"models\s*=\s*\[(.*?)\]", r).group(1))
         lo = float(re.search(r"mason_min\s*=\s*([\d.e+-]+)", r).group(1))
         hi = float(re.search(r"mason_max\s*=\s*([\d.e+-]+)", r).group(1))
         seeds = [int(x) for x in re.search(r"seeds\s*=\s*\[(.*?)\]", r).group(1).split(",")]
+        sets = re.search(r"set\s*=\s*\[(.*?)\]", r, re.S).group(1).strip()
         strain = float(re.search(r"drive\.strain=([\d.]+)", r).group(1))
-        done = True
+        # one rule per point whose re-run has finished (the others read as their first runs)
         for m in models:
             for mn in [g for g in GRID if lo <= g <= hi]:
                 for sd in seeds:
                     f = os.path.join(archive, m, f"mn_{mn:g}_seed_{sd}", "summary.json")
-                    if not os.path.exists(f) or json.load(open(f))["strain"] != strain:
-                        done = False
+                    if os.path.exists(f) and json.load(open(f))["strain"] == strain:
+                        keep.append(f'\nmodels = ["{m}"]\nmason_min = {mn!r}\nmason_max = {mn!r}\nseeds = [{sd}]\n'
+                                    f'set = [{sets}]\n\n')
+                    else:
                         pending.append(f"{m} Mn {mn:g} seed {sd}")
-        if done:
-            keep.append(r)
     with open(out_path, "w") as fh:
         fh.write(head + "".join("[[rule]]" + r for r in keep))
     return pending

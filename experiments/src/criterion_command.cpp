@@ -28,6 +28,8 @@ ordered_json fit_json(const mrf::FlowFit& f) {
           {"mason_star_err", f.mason_star_err},
           {"exponent", f.exponent},
           {"exponent_err", f.exponent_err},
+          {"slope", f.slope},
+          {"slope_err", f.slope_err},
           {"chi2_dof", f.chi2_dof},
           {"dof", f.dof}};
 }

@@ -19,6 +19,7 @@
 #include "mrf/io/lammps_data.hpp"
 #include "mrf/scene/build_model.hpp"
 #include "mrf/scene/run.hpp"
+#include "mrf/scene/run_series.hpp"
 #include "mrf/study/sweep.hpp"
 #include "mrf/version.hpp"
 
@@ -93,13 +94,11 @@ int sweep_command(const SweepArgs& a) {
   if (!a.calibrate.empty() && !std::filesystem::is_directory(a.calibrate))
     throw mrf::InputError("--calibrate-from", a.calibrate, "", "is not a folder (of finished points' summary.json)");
   opt.write_csv = !a.no_csv;
-  if (a.collect || a.list || a.estimate)  // a run sets aside its own share (run_sweep)
-    mrf::set_aside_stale(spec, mrf::sweep_points(spec), out, a.quiet);
   if (!a.archive.empty() && (a.collect || a.list || a.estimate))  // a run restores its own share (run_sweep)
     mrf::report_archive(mrf::restore_from_archive(spec, mrf::sweep_points(spec), out, a.archive), a.archive, a.quiet);
   if (a.collect) {  // sweep.csv from the finished points, nothing run (while other ranks still work)
     const auto points = mrf::sweep_points(spec);
-    const std::size_t done = mrf::write_sweep_csv(points, out);
+    const std::size_t done = mrf::write_sweep_csv(points, out, &spec);
     std::printf("%zu of %zu points finished -> %s/sweep.csv\n", done, points.size(), out.c_str());
     return 0;
   }
@@ -112,7 +111,10 @@ int sweep_command(const SweepArgs& a) {
                 "estimate (s; * = from the particle-steps model, no point of the model finished)");
     for (const auto& p : points) {
       const std::filesystem::path dir = std::filesystem::path(out) / p.dir;
-      const char* state = std::filesystem::exists(dir / "summary.json")   ? "finished"
+      const std::string id = mrf::folder_scene_id(dir);
+      const bool stale = !id.empty() && id != mrf::scene_id(mrf::load_scene(spec.scene_path, p.sets).config);
+      const char* state = stale                                           ? "stale"
+                          : std::filesystem::exists(dir / "summary.json")   ? "finished"
                           : std::filesystem::exists(dir / "failure.json") ? "failed"
                           : std::filesystem::exists(dir / "checkpoint.bin") ? "started"
                                                                               : "todo";

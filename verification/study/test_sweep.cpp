@@ -184,14 +184,32 @@ TEST(Sweep, KilledSweepResumesAndReproduces) {
   EXPECT_TRUE(archived.calibrated[1] && archived.calibrated[2]);
   EXPECT_DOUBLE_EQ(archived.seconds[1], read_json(p1 / "summary.json")["seconds_per_strain"].get<double>() * 0.6);
   // --calibrate-from: the same folder read for the cost alone (a fresh run
-  // estimated from an earlier one's measured cost) gives the same estimates,
-  // and restores nothing.
+  // estimated from an earlier one's measured cost) gives the same estimates;
+  // the archive, where it has the point, comes first.
   const PointEstimates calibrated =
       estimate_points(wider, pts, (out / "nothing_here").string(), 1e6, "", out.string());
   EXPECT_TRUE(calibrated.calibrated[1] && calibrated.calibrated[2]);
   EXPECT_DOUBLE_EQ(calibrated.seconds[1], archived.seconds[1]);
   EXPECT_DOUBLE_EQ(calibrated.seconds[2], archived.seconds[2]);
-  EXPECT_FALSE(std::filesystem::exists(out / "nothing_here"));
+  const PointEstimates both =
+      estimate_points(wider, pts, (out / "nothing_here").string(), 1e6, out.string(), (out / "nothing_here").string());
+  EXPECT_DOUBLE_EQ(both.seconds[1], archived.seconds[1]);
+  // A sweep with --calibrate-from runs its points: nothing is restored from
+  // the calibration folder; its seconds per strain unit give the estimate.
+  SweepOptions cal = opt;
+  cal.calibrate = out.string();
+  const auto fresh_out = std::filesystem::temp_directory_path() / "mrf_test_sweep_calibrated";
+  std::filesystem::remove_all(fresh_out);
+  const SweepSpec short_one = parse_sweep(
+      "[sweep]\nscene = \"small_dem_stokes.toml\"\nmodels = [\"dem_stokes\"]\nmason = [1.0]\nseeds = [3]\n"
+      "set = [\"drive.strain=0.6\", \"drive.warmup_strain=0.2\"]\n",
+      "tiny.toml", k_scenes);
+  const SweepOutcome calibrated_run = run_sweep(short_one, fresh_out.string(), cal);
+  EXPECT_EQ(calibrated_run.ran, 1u);
+  EXPECT_EQ(calibrated_run.skipped, 0u);
+  EXPECT_NEAR(calibrated_run.estimated_seconds, read_json(p1 / "summary.json")["seconds_per_strain"].get<double>() * 0.6,
+              1e-9);
+  std::filesystem::remove_all(fresh_out);
 
   // `--point K` (what a job array hands out) runs point K alone, into the
   // same folder with the same result; a K outside the grid is refused.

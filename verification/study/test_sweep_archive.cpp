@@ -43,6 +43,26 @@ TEST(SweepArchive, SceneIdChangesWithEveryParameterAndOnlyThen) {
   EXPECT_EQ(scene_id(load_scene(path, {"numerics.newton_tol=1e-6"}).config), base);
 }
 
+// The committed archive of the paper study still matches the scenes its
+// sweep file defines: a change of the scene fingerprint (a new scene key
+// entered at its default, say) would make every committed point stale and
+// run again. Every entry is checked but those whose re-run for steadiness
+// (another strain, by a rule of the sweep file) is still pending.
+TEST(SweepArchive, TheCommittedPaperArchiveMatchesItsSweepFile) {
+  const SweepSpec paper = load_sweep(MRF_SOURCE_DIR "/experiments/sweeps/paper_realistic.toml");
+  int checked = 0;
+  for (const SweepPoint& p : sweep_points(paper)) {
+    const auto entry = std::filesystem::path(MRF_SOURCE_DIR "/reports/study/paper/points") / p.dir / "summary.json";
+    ASSERT_TRUE(std::filesystem::exists(entry)) << entry;
+    const nlohmann::json j = nlohmann::json::parse(slurp(entry));
+    const SceneConfig c = load_scene(paper.scene_path, p.sets).config;
+    if (j["strain"].get<double>() != c.strain) continue;  // a re-run pending: the entry is its first run
+    EXPECT_EQ(j["scene_id"].get<std::string>(), scene_id(c)) << p.dir;
+    ++checked;
+  }
+  EXPECT_GE(checked, 30);
+}
+
 TEST(SweepArchive, FinishedPointsSurviveTheLossOfTheOutputAndStaleEntriesRunAgain) {
   const auto root = std::filesystem::temp_directory_path() / "mrf_test_sweep_archive";
   std::filesystem::remove_all(root);
@@ -96,9 +116,10 @@ TEST(SweepArchive, FinishedPointsSurviveTheLossOfTheOutputAndStaleEntriesRunAgai
 }
 
 // The same rule for the output folder (no archive): after an edit of the
-// sweep file, a finished point's folder holds a run of another scene; the
-// sweep moves it to <folder>.stale and runs the point again, and --collect
-// never lists the old run as the point's.
+// sweep file a finished point's folder holds a run of another scene. A
+// read-only collect lists it as stale (and moves nothing); the sweep moves
+// it to <folder>.stale-<its scene_id> and runs the point again; reverting
+// the edit brings the first runs back instead of running them again.
 TEST(SweepArchive, AFinishedRunOfAnotherSceneInTheOutputRunsAgain) {
   const auto root = std::filesystem::temp_directory_path() / "mrf_test_sweep_stale_output";
   std::filesystem::remove_all(root);
@@ -109,35 +130,48 @@ TEST(SweepArchive, AFinishedRunOfAnotherSceneInTheOutputRunsAgain) {
   ASSERT_EQ(run_sweep(s, out, opt).ran, 2u);
   EXPECT_EQ(run_sweep(s, out, opt).ran, 0u);  // unchanged: nothing runs, nothing moves
   const auto pts = sweep_points(s);
-  EXPECT_FALSE(std::filesystem::exists(root / "out" / (pts[0].dir + ".stale")));
+  const std::string id_s = scene_id(load_scene(s.scene_path, pts[0].sets).config);
+  EXPECT_EQ(folder_scene_id(root / "out" / pts[0].dir), id_s);
   const std::string old0 = slurp(root / "out" / pts[0].dir / "summary.json");
 
   const SweepSpec edited = tiny("0.8");
-  const auto moved = set_aside_stale(edited, sweep_points(edited), out, true);  // what --collect does first
-  EXPECT_EQ(moved.size(), 2u);
-  EXPECT_EQ(slurp(root / "out" / (pts[0].dir + ".stale") / "summary.json"), old0);
-  EXPECT_EQ(write_sweep_csv(sweep_points(edited), out), 0u);  // no point of the edited sweep is finished
+  const auto pe = sweep_points(edited);
+  EXPECT_EQ(write_sweep_csv(pe, out, &edited), 0u);  // what --collect does: nothing finished, nothing moved
+  EXPECT_NE(slurp(root / "out" / "sweep.csv").find(",stale,"), std::string::npos);
+  EXPECT_EQ(slurp(root / "out" / pts[0].dir / "summary.json"), old0);
   const SweepOutcome again = run_sweep(edited, out, opt);
   EXPECT_EQ(again.ran, 2u);
+  EXPECT_EQ(slurp(root / "out" / (pts[0].dir + ".stale-" + id_s) / "summary.json"), old0);
   EXPECT_EQ(nlohmann::json::parse(slurp(root / "out" / pts[0].dir / "summary.json"))["strain"], 0.8);
-  EXPECT_TRUE(set_aside_stale(edited, sweep_points(edited), out, true).empty());
+  EXPECT_EQ(write_sweep_csv(pe, out, &edited), 2u);
+  EXPECT_TRUE(set_aside_stale(edited, pe, out, true).empty());
 
-  // An unfinished run (a checkpoint, no summary) of the old scene: resuming
-  // it would be refused, so it is set aside too; one of the current scene is
-  // left to resume.
-  const auto pe = sweep_points(edited);
+  // The edit reverted: the 0.8 runs go aside, the 0.6 runs come back.
+  EXPECT_EQ(set_aside_stale(s, pts, out, true).size(), 2u);
+  EXPECT_EQ(slurp(root / "out" / pts[0].dir / "summary.json"), old0);
+  EXPECT_EQ(run_sweep(s, out, opt).ran, 0u);
+
+  // A failure of another scene (failure.json carries the scene_id) is moved
+  // too; an unfinished run (a checkpoint, no summary) of another scene as
+  // well, whose resume would be refused; one of the current scene stays.
+  std::filesystem::remove_all(root / "out" / pe[1].dir);
+  std::filesystem::create_directories(root / "out" / pe[1].dir);
+  std::ofstream(root / "out" / pe[1].dir / "failure.json") << "{\"scene_id\": \"" << id_s << "\"}";
   std::filesystem::remove_all(root / "out" / pe[0].dir);
   RunOptions cut;
   cut.out_dir = (root / "out" / pe[0].dir).string();
   cut.quiet = true;
   cut.checkpoint_every_rows = 5;
   cut.stop_after_steps = 40;
-  EXPECT_THROW(run_scene(load_scene(s.scene_path, sweep_points(s)[0].sets), cut), RunInterrupted);  // the old scene
+  EXPECT_THROW(run_scene(load_scene(s.scene_path, pts[0].sets), cut), RunInterrupted);  // the old scene
   ASSERT_TRUE(std::filesystem::exists(root / "out" / pe[0].dir / "checkpoint.bin"));
-  EXPECT_EQ(set_aside_stale(edited, pe, out, true), std::vector<std::string>{pe[0].dir});
+  EXPECT_EQ(folder_scene_id(root / "out" / pe[0].dir), id_s);
+  EXPECT_EQ(set_aside_stale(edited, pe, out, true), (std::vector<std::string>{pe[0].dir, pe[1].dir}));
+  EXPECT_TRUE(std::filesystem::exists(root / "out" / pe[0].dir / "summary.json"));  // the 0.8 run came back
+  std::filesystem::remove_all(root / "out" / pe[0].dir);
   EXPECT_THROW(run_scene(load_scene(edited.scene_path, pe[0].sets), cut), RunInterrupted);  // the current one
   ASSERT_TRUE(std::filesystem::exists(root / "out" / pe[0].dir / "checkpoint.bin"));
-  EXPECT_TRUE(set_aside_stale(edited, pe, out, true).empty());
+  EXPECT_TRUE(set_aside_stale(edited, {pe[0]}, out, true).empty());
   std::filesystem::remove_all(root);
 }
 

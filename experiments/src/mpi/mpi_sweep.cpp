@@ -116,7 +116,7 @@ int mpi_sweep(const mrf::SweepSpec& spec, const std::string& out, const mrf::Swe
       MPI_Send(&job, 1, MPI_LONG, st.MPI_SOURCE, k_work, MPI_COMM_WORLD);
       if (job < 0) --active;
     }
-    mrf::write_sweep_csv(points, out);
+    mrf::write_sweep_csv(points, out, &spec);
     std::printf("sweep (MPI, %d ranks): %ld run, %zu skipped (finished before), %ld failed, %zu died -> %s/sweep.csv\n",
                 size, ran, points.size() - order.size(), failed, died.size(), out.c_str());
     for (const std::string& d : died)

@@ -234,18 +234,20 @@ std::string scene_fingerprint(const SceneConfig& c) {
          std::to_string(c.threads) + ";" + std::to_string(c.implicit_order) + ";" + std::to_string(c.every) + ";" + std::to_string(c.frames);
   // added after points were archived: only a value other than the default
   // enters, so that the scene_id of every earlier scene stays what it was
-  if (c.newton_tol != SceneConfig{}.newton_tol) {
+  if (c.newton_tol != 1e-6) {  // the default when the key came; a literal, so a new default cannot alias it
     std::snprintf(buf, sizeof buf, ";newton_tol %a", c.newton_tol);
     out += buf;
   }
   return out;
 }
 
-std::string scene_id(const SceneConfig& c) {
+std::string fingerprint_id(const std::string& fingerprint) {
   char buf[16];
-  std::snprintf(buf, sizeof buf, "%08x", static_cast<unsigned>(crc32(scene_fingerprint(c))));
+  std::snprintf(buf, sizeof buf, "%08x", static_cast<unsigned>(crc32(fingerprint)));
   return buf;
 }
+
+std::string scene_id(const SceneConfig& c) { return fingerprint_id(scene_fingerprint(c)); }
 
 RunFiles::RunFiles(const RunOptions& opt, const SceneConfig& c)
     : opt_(opt),

@@ -85,6 +85,8 @@ FlowFit fit_bingham(const std::vector<double>& mason, const std::vector<double>&
   c11 *= inflate;
   f.eta_inf = a;
   f.eta_inf_err = std::sqrt(c00);
+  f.slope = b;
+  f.slope_err = std::sqrt(c11);
   f.exponent = 1.0;
   if (a <= 0) {
     f.message = "Bingham fit gives eta_inf <= 0: the data are not Bingham-like";

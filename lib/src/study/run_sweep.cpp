@@ -16,6 +16,7 @@
 #include "mrf/scene/dem_params.hpp"
 #include "mrf/scene/build_model.hpp"
 #include "mrf/scene/run.hpp"
+#include "mrf/scene/run_series.hpp"
 #include "mrf/study/sweep.hpp"
 #include "mrf/vec.hpp"
 
@@ -226,7 +227,7 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
       ++outcome.failed;
       std::filesystem::create_directories(dir);
       nlohmann::json j{{"model", t.point->model}, {"mason", t.point->mason}, {"seed", t.point->seed},
-                       {"error", e.what()}};
+                       {"scene_id", scene_id(t.scene.config)}, {"error", e.what()}};
       write_file_atomic(dir + "/failure.json", j.dump(2) + "\n");
       std::fprintf(stderr, "mrf sweep: point %s failed: %s\n", t.point->dir.c_str(), e.what());
     }
@@ -243,7 +244,7 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
     }
   }
   outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  if (opt.write_csv) write_sweep_csv(points, out_dir);
+  if (opt.write_csv) write_sweep_csv(points, out_dir, &spec);
   return outcome;
 }
 

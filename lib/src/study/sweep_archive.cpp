@@ -48,41 +48,62 @@ ArchiveSync restore_from_archive(const SweepSpec& spec, const std::vector<SweepP
   return sync;
 }
 
+std::string folder_scene_id(const std::filesystem::path& dir) {
+  // summary.json and failure.json carry the scene_id; a run under way has
+  // its scene's fingerprint first in the checkpoint
+  for (const char* name : {"summary.json", "failure.json"}) {
+    if (!std::filesystem::exists(dir / name)) continue;
+    const nlohmann::json j = nlohmann::json::parse(read_text(dir / name), nullptr, false);
+    return !j.is_discarded() && j.contains("scene_id") && j["scene_id"].is_string() ? j["scene_id"].get<std::string>()
+                                                                                     : std::string();
+  }
+  if (!std::filesystem::exists(dir / "checkpoint.bin")) return {};
+  try {
+    ArchiveReader in((dir / "checkpoint.bin").string());
+    std::string fp;
+    in.get(fp);
+    return fingerprint_id(fp);
+  } catch (const NumericalError&) {
+    return {};  // a damaged checkpoint: the run's resume says so
+  }
+}
+
 std::vector<std::string> set_aside_stale(const SweepSpec& spec, const std::vector<SweepPoint>& points,
                                          const std::string& out_dir, bool quiet) {
   std::vector<std::string> moved;
   for (const SweepPoint& p : points) {
     const auto dir = std::filesystem::path(out_dir) / p.dir;
-    const auto summary = dir / "summary.json", checkpoint = dir / "checkpoint.bin";
-    if (std::filesystem::exists(summary)) {  // a finished run
-      const nlohmann::json j = nlohmann::json::parse(read_text(summary), nullptr, false);
-      if (j.is_discarded() || !j.contains("scene_id") || !j["scene_id"].is_string()) continue;
-      if (j["scene_id"].get<std::string>() == scene_id(load_scene(spec.scene_path, p.sets).config)) continue;
-    } else if (std::filesystem::exists(checkpoint)) {  // a run under way, which --resume would refuse
-      try {
-        ArchiveReader in(checkpoint.string());
-        std::string fp;
-        in.get(fp);
-        if (fp == scene_fingerprint(load_scene(spec.scene_path, p.sets).config)) continue;
-      } catch (const NumericalError&) {
-        continue;  // a damaged checkpoint: the run's resume says so
+    const std::string want = scene_id(load_scene(spec.scene_path, p.sets).config);
+    const std::string have = folder_scene_id(dir);
+    if (!have.empty() && have != want) {
+      // kept under the scene it was made for: a later run of that scene
+      // replaces it, a return to that scene takes it back (below)
+      const auto aside = std::filesystem::path(dir.string() + ".stale-" + have);
+      std::error_code ec;
+      std::filesystem::remove_all(aside, ec);
+      std::filesystem::rename(dir, aside, ec);
+      if (ec) {
+        if (!std::filesystem::exists(dir)) continue;  // another process moved it first
+        throw OutputError(dir.string() + ": cannot move a run of another scene aside to " + aside.string() + ": " +
+                          ec.message());
       }
-    } else {
-      continue;
+      moved.push_back(p.dir);
+      if (!quiet)
+        std::fprintf(stderr, "mrf sweep: %s holds a run of another scene (scene_id %s, the point's is %s): moved to "
+                             "%s; the point runs again\n", dir.string().c_str(), have.c_str(), want.c_str(),
+                     aside.string().c_str());
     }
-    const auto aside = std::filesystem::path(dir.string() + ".stale");
-    std::error_code ec;
-    std::filesystem::remove_all(aside, ec);
-    std::filesystem::rename(dir, aside, ec);
-    if (ec) {
-      if (!std::filesystem::exists(dir)) continue;  // another process moved it first
-      throw OutputError(dir.string() + ": cannot move a run of another scene aside to " + aside.string() + ": " +
-                        ec.message());
+    // A finished run of this very scene set aside earlier comes back.
+    const auto mine = std::filesystem::path(dir.string() + ".stale-" + want);
+    if (!std::filesystem::exists(dir / "summary.json") && std::filesystem::exists(mine / "summary.json") &&
+        folder_scene_id(mine) == want) {
+      std::error_code ec;
+      std::filesystem::remove_all(dir, ec);
+      std::filesystem::rename(mine, dir, ec);
+      if (!ec && !quiet)
+        std::fprintf(stderr, "mrf sweep: %s: its finished run of this scene is back from %s\n", dir.string().c_str(),
+                     mine.string().c_str());
     }
-    moved.push_back(p.dir);
-    if (!quiet)
-      std::fprintf(stderr, "mrf sweep: %s holds a run of another scene (scene_id differs): moved to %s; the point "
-                           "runs again\n", dir.string().c_str(), aside.string().c_str());
   }
   return moved;
 }

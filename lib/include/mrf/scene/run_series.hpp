@@ -131,6 +131,8 @@ std::string scene_fingerprint(const SceneConfig& c);
 // Its CRC-32 as 8 hex digits: summary.json's scene_id, by which a sweep
 // archive tells a result of this scene from one of an edited scene.
 std::string scene_id(const SceneConfig& c);
+// The same CRC-32 of a fingerprint as read from a checkpoint.
+std::string fingerprint_id(const std::string& fingerprint);
 
 // The files of a run loop in RunOptions::out_dir (none when it is empty):
 // timeseries.csv, frames.xyz, checkpoint.bin and summary.json. A checkpoint

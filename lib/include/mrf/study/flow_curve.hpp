@@ -58,6 +58,9 @@ struct FlowFit {
   double eta_inf = 0, eta_inf_err = 0;      // relative high-shear viscosity (1)
   double mason_star = 0, mason_star_err = 0;
   double exponent = 1, exponent_err = 0;    // Delta; fixed at 1 (err 0) for Bingham
+  // Bingham: b of eta_r = eta_inf + b / Mn (= eta_inf Mn*), with its error
+  // (covariance inflated as the others); tau_y / (phi mu0 M^2) = b / (4.5 phi)
+  double slope = 0, slope_err = 0;
   double chi2_dof = 0;
   int dof = 0;
   bool ok = false;

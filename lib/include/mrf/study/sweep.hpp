@@ -28,6 +28,7 @@
 // Errors are InputErrors naming the key and FILE:LINE.
 #pragma once
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -94,11 +95,17 @@ RankInfo rank_from_environment();
 bool point_finished(const std::string& point_dir);
 
 // sweep.csv text: one row per point of `points` that has a summary.json or a
-// failure.json under `out_dir`, with the DESIGN.md summary fields.
-std::string sweep_csv(const std::vector<SweepPoint>& points, const std::string& out_dir);
+// failure.json under `out_dir`, with the DESIGN.md summary fields. With the
+// sweep's spec, a folder made for another scene (folder_scene_id differs
+// from the point's) gets status `stale` and no fields: no table reads it as
+// the point's (set_aside_stale moves it when the point runs).
+std::string sweep_csv(const std::vector<SweepPoint>& points, const std::string& out_dir,
+                      const SweepSpec* spec = nullptr);
 // out_dir/sweep.csv rewritten atomically from that text (the folder created
-// if need be); returns the number of finished points (summary.json or failure.json).
-std::size_t write_sweep_csv(const std::vector<SweepPoint>& points, const std::string& out_dir);
+// if need be); returns the number of finished points (summary.json or
+// failure.json, not stale).
+std::size_t write_sweep_csv(const std::vector<SweepPoint>& points, const std::string& out_dir,
+                            const SweepSpec* spec = nullptr);
 
 struct SweepOptions {
   bool quiet = false;       // no progress on stderr
@@ -172,15 +179,23 @@ void archive_point(const SweepPoint& p, const std::string& out_dir, const std::s
 // What a restore did, on stderr (nothing when quiet).
 void report_archive(const ArchiveSync& sync, const std::string& archive_dir, bool quiet);
 
-// The same rule for the sweep output itself: a point folder under out_dir
-// whose summary.json was written for another scene (its scene_id differs
-// from the point's as the sweep file now defines it: a rule, an override or
-// the scene edited since it ran), or, unfinished, whose checkpoint.bin was
-// (its scene fingerprint differs), is moved to <folder>.stale (replacing an
-// earlier one), so that the point runs again from the start and no table
-// reads the old run as this point's. A summary without a scene_id (an older
-// mrf), a damaged checkpoint and a failure.json are left alone. Returns the point folders moved; says so on
-// stderr unless quiet.
+// The scene_id a point folder's run was made for (summary.json,
+// failure.json, or the checkpoint's fingerprint); empty when it cannot be
+// told.
+std::string folder_scene_id(const std::filesystem::path& dir);
+
+// The same rule for the sweep output itself, applied by the process that
+// runs the points (run_sweep for its share, the MPI master for the grid):
+// a point folder made for another scene (the scene_id of its summary.json
+// or failure.json, or of its checkpoint's fingerprint, differs from the
+// point's as the sweep file now defines it: a rule, an override or the
+// scene edited since) is moved to <folder>.stale-<its scene_id>, replacing
+// an earlier one of that scene, so that the point runs again from the start;
+// and a finished run of the point's own scene found under
+// <folder>.stale-<scene_id> (a sweep file edited and then reverted) comes
+// back instead of running again. A folder whose scene cannot be told (no
+// scene_id: an older mrf; a damaged checkpoint) is left alone. Returns the
+// point folders moved aside; says so on stderr unless quiet.
 std::vector<std::string> set_aside_stale(const SweepSpec& spec, const std::vector<SweepPoint>& points,
                                          const std::string& out_dir, bool quiet);
 
