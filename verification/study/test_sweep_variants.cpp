@@ -86,6 +86,38 @@ TEST(SweepRules, SeedsSelectThePointsARuleLengthens) {
   }
 }
 
+TEST(SweepRules, ARuleNamingVariantsRefinesThemAfterTheirOwnOverrides) {
+  // a longer run of the "stiff" variant alone, at its Mn and for seed 2 (a
+  // convergence variant that failed a steadiness test): its strain wins over
+  // the variant's own, and every other point keeps its overrides
+  const std::string t = text("mason = [0.01]\n", k_two + "[[rule]]\nvariants = [\"stiff\"]\nmodels = [\"dem_stokes\"]\n"
+                                                      "seeds = [2]\nset = [\"drive.strain=6\"]\n");
+  const auto pts = sweep_points(parse_sweep(t, "v.toml", k_scenes));
+  const auto plain = sweep_points(parse_sweep(text("mason = [0.01]\n", k_two), "v.toml", k_scenes));
+  ASSERT_EQ(pts.size(), plain.size());
+  int refined = 0;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    if (pts[i].variant == "stiff" && pts[i].model == "dem_stokes" && pts[i].seed == 2) {
+      const std::vector<std::string> want{"drive.strain=4", "contact.youngs_modulus=2e12", "drive.strain=3",
+                                          "drive.strain=6", "scene.model=\"dem_stokes\"", "drive.mason=0.5",
+                                          "scene.seed=2"};
+      EXPECT_EQ(pts[i].sets, want);
+      ++refined;
+    } else {
+      EXPECT_EQ(pts[i].sets, plain[i].sets) << pts[i].dir;
+    }
+  }
+  EXPECT_EQ(refined, 1);
+  try {
+    parse_sweep(text("mason = [0.01]\n", k_two + "[[rule]]\nvariants = [\"soft\"]\nset = [\"drive.strain=6\"]\n"),
+                "v.toml", k_scenes);
+    FAIL() << "a rule naming no variant of the sweep must be refused";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), "rule.variants") << e.what();
+    EXPECT_NE(std::string(e.what()).find("soft"), std::string::npos) << e.what();
+  }
+}
+
 TEST(SweepVariants, SweepMasonMayBeLeftOutOnlyWhenEveryVariantHasItsOwn) {
   const std::string own = "[[variant]]\nname = \"a\"\nmason = [0.1]\n[[variant]]\nname = \"b\"\nmason = [0.2, 0.3]\n";
   EXPECT_EQ(sweep_points(parse_sweep(text("", own), "v.toml", k_scenes)).size(), 2u * 3u * 2u);

@@ -192,6 +192,11 @@ SweepSpec parse_sweep(const std::string& toml_text, const std::string& source, c
           const auto* a = v.as_array();
           if (!a) throw InputError("rule.set", text_of(v), where_of(v, source), "expected an array of section.key=value");
           r.set = strings(*a, "rule.set", source);
+        } else if (key == "variants") {
+          const auto* a = v.as_array();
+          if (!a || a->empty())
+            throw InputError("rule.variants", text_of(v), where_of(v, source), "expected a non-empty array of variant names");
+          r.variants = strings(*a, "rule.variants", source);
         } else {
           throw InputError("rule." + key, text_of(v), where_of(v, source), "unknown key");
         }
@@ -201,6 +206,10 @@ SweepSpec parse_sweep(const std::string& toml_text, const std::string& source, c
     }
   }
   if (const toml::node* variants = root.get("variant")) parse_variants(*variants, source, s);
+  for (const auto& r : s.rules)
+    for (const auto& name : r.variants)
+      if (std::none_of(s.variants.begin(), s.variants.end(), [&](const SweepVariant& v) { return v.name == name; }))
+        throw InputError("rule.variants", "\"" + name + "\"", source, "not the name of a [[variant]] of this sweep");
   return s;
 }
 
@@ -228,14 +237,19 @@ std::vector<SweepPoint> sweep_points(const SweepSpec& spec) {
           p.seed = seed;
           p.variant = v.name;
           p.sets = spec.set;
-          for (const auto& r : spec.rules) {
+          const auto applies = [&](const SweepRule& r) {
             const bool model_ok =
                 r.models.empty() || std::find(r.models.begin(), r.models.end(), model) != r.models.end();
             const bool mn_ok = (r.mason_min == 0 || mn >= r.mason_min) && (r.mason_max == 0 || mn <= r.mason_max);
             const bool seed_ok = r.seeds.empty() || std::find(r.seeds.begin(), r.seeds.end(), seed) != r.seeds.end();
-            if (model_ok && mn_ok && seed_ok) p.sets.insert(p.sets.end(), r.set.begin(), r.set.end());
-          }
+            return model_ok && mn_ok && seed_ok;
+          };
+          for (const auto& r : spec.rules)
+            if (r.variants.empty() && applies(r)) p.sets.insert(p.sets.end(), r.set.begin(), r.set.end());
           p.sets.insert(p.sets.end(), v.set.begin(), v.set.end());
+          for (const auto& r : spec.rules)  // rules that refine a variant come after its overrides
+            if (std::find(r.variants.begin(), r.variants.end(), v.name) != r.variants.end() && applies(r))
+              p.sets.insert(p.sets.end(), r.set.begin(), r.set.end());
           p.sets.push_back("scene.model=\"" + model + "\"");
           p.sets.push_back("drive.mason=" + format_number(mn));  // reads back exactly: the run and sweep.csv agree
           p.sets.push_back("scene.seed=" + std::to_string(seed));

@@ -40,6 +40,10 @@ struct SweepRule {
   double mason_min = 0, mason_max = 0;  // 0 = no bound
   std::vector<std::string> models;      // empty = all
   std::vector<std::uint64_t> seeds;     // empty = all (a longer run for the seeds that failed a steadiness test)
+  // empty = every point, its overrides before the variant's; else the
+  // variants it refines, its overrides after theirs (a longer run of one
+  // convergence variant that failed a steadiness test)
+  std::vector<std::string> variants;
   std::vector<std::string> set;
 };
 
