@@ -10,7 +10,9 @@ strain (the others' points then read as their first runs), collects it from
 the archive, runs `mrf criterion`, copies sweep.csv and criterion.json into
 reports/study/paper/ and writes the report with --note NOTE. The fixed-M
 path's tables are refreshed from reports/study/paper/fixed_m_points the same
-way (a point whose re-run is pending reads as its first run there too).
+way (a point whose re-run is pending reads as its first run there too), and
+so is the convergence table (reports/study/paper/convergence.md) from
+reports/study/paper/convergence/points.
 
 usage: scripts/paper_interim.py [--mrf build/mrf] [--note TEXT]
 """
@@ -44,19 +46,24 @@ def interim_toml(src_path, archive, out_path):
         models = re.findall(r'"(\w+)"', re.search(r"models\s*=\s*\[(.*?)\]", r).group(1))
         lo = float(re.search(r"mason_min\s*=\s*([\d.e+-]+)", r).group(1))
         hi = float(re.search(r"mason_max\s*=\s*([\d.e+-]+)", r).group(1))
-        seeds = [int(x) for x in re.search(r"seeds\s*=\s*\[(.*?)\]", r).group(1).split(",")]
-        sets = re.search(r"set\s*=\s*\[(.*?)\]", r, re.S).group(1).strip()
+        sd_text = re.search(r"seeds\s*=\s*\[(.*?)\]", r)
+        seeds = [int(x) for x in sd_text.group(1).split(",")] if sd_text else [1]  # the convergence sweep: seed 1
+        var_text = re.search(r"variants\s*=\s*\[(.*?)\]", r)
+        variants = re.findall(r'"([\w.-]+)"', var_text.group(1)) if var_text else [""]
+        sets = re.search(r"^set\s*=\s*\[(.*?)\]", r, re.S | re.M).group(1).strip()
         strain = float(re.search(r"drive\.strain=([\d.]+)", r).group(1))
         # one rule per point whose re-run has finished (the others read as their first runs)
         for m in models:
-            for mn in [g for g in GRID if lo <= g <= hi]:
-                for sd in seeds:
-                    f = os.path.join(archive, m, f"mn_{mn:g}_seed_{sd}", "summary.json")
-                    if os.path.exists(f) and json.load(open(f))["strain"] == strain:
-                        keep.append(f'\nmodels = ["{m}"]\nmason_min = {mn!r}\nmason_max = {mn!r}\nseeds = [{sd}]\n'
-                                    f'set = [{sets}]\n\n')
-                    else:
-                        pending.append(f"{m} Mn {mn:g} seed {sd}")
+            for v in variants:
+                for mn in [g for g in GRID if lo <= g <= hi]:
+                    for sd in seeds:
+                        f = os.path.join(archive, m, v, f"mn_{mn:g}_seed_{sd}", "summary.json")
+                        if os.path.exists(f) and json.load(open(f))["strain"] == strain:
+                            keep.append(("\nvariants = [\"" + v + "\"]" if v else "")
+                                        + f'\nmodels = ["{m}"]\nmason_min = {mn!r}\nmason_max = {mn!r}\n'
+                                        f'seeds = [{sd}]\nset = [{sets}]\n\n')
+                        else:
+                            pending.append(f"{m} {v + ' ' if v else ''}Mn {mn:g} seed {sd}")
     with open(out_path, "w") as fh:
         fh.write(head + "".join("[[rule]]" + r for r in keep))
     return pending
@@ -84,6 +91,15 @@ def main():
             collect(mrf, tmp, out, archive)
             shutil.copy(os.path.join(out, "sweep.csv"), os.path.join(paper, csv_name))
             shutil.copy(os.path.join(out, "criterion.json"), os.path.join(paper, crit_name))
+        # the convergence variants against the realistic path's seed means
+        pending = interim_toml(os.path.join(sweeps, "paper_convergence.toml"), f"{paper}/convergence/points", tmp)
+        print(f"paper_convergence: re-runs pending: {', '.join(pending) if pending else 'none'}")
+        out = os.path.join("out", "sweeps", "paper_convergence_interim")
+        shutil.rmtree(out, ignore_errors=True)
+        subprocess.run([mrf, "sweep", tmp, "--out", out, "--archive", f"{paper}/convergence/points", "--collect",
+                        "--quiet"], check=True)
+        subprocess.run(["/usr/bin/python3", "reports/paper_convergence.py", os.path.join(out, "sweep.csv"),
+                        os.path.join(paper, "sweep.csv"), os.path.join(paper, "convergence.md")], check=True)
     finally:
         if os.path.exists(tmp):
             os.remove(tmp)
