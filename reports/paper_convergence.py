@@ -37,6 +37,26 @@ def f(r, k):
         return float("nan")
 
 
+def plot(bars, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    groups = sorted({b[0] for b in bars})
+    fig, axs = plt.subplots(1, len(groups), figsize=(3.2 * len(groups), 3.6), sharex=False)
+    for ax, g in zip(axs if len(groups) > 1 else [axs], groups):
+        mine = [b for b in bars if b[0] == g]
+        for y, (_, v, sh, err, ok) in enumerate(mine):
+            ax.errorbar([sh], [y], xerr=[err], fmt="o", mfc="C0" if ok else "none", color="C0", capsize=3)
+        ax.axvline(0, color="k", lw=0.8)
+        ax.set_yticks(range(len(mine)), [b[1] for b in mine], fontsize=7)
+        ax.set_title(f"{g[0]}, Mn {g[1]:g}", fontsize=8)
+        ax.set_xlabel("shift of the wall stress (%)", fontsize=7)
+        ax.tick_params(axis="x", labelsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
 def main(argv):
     if len(argv) < 2:
         print(__doc__)
@@ -57,6 +77,7 @@ def main(argv):
              "| model | Mn | variant | wall stress | base (seeds) | shift | shift / sigma | particle part shift | "
              "variant steady | s per strain |", "|---|---:|---|---:|---:|---:|---:|---:|---|---:|"]
     lever = {}  # (model, Mn) -> (|shift|, variant, shift, sigma, steady): the largest mover
+    bars = []  # (model, Mn), variant, shift %, its combined error %, steady: the figure
     for r in sorted(conv, key=lambda r: (r["model"], float(r["mason"]), r["variant"])):
         key = (r["model"], float(r["mason"]))
         b = base.get(key, [])
@@ -78,6 +99,7 @@ def main(argv):
         pm = statistics.mean(bp)
         vp = (f(r, "stress_total") - f(r, "stress_fluid")) / sc
         z = (t - bm) / math.hypot(be, ve)
+        bars.append((key, r["variant"], 100 * (t / bm - 1), 100 * math.hypot(ve, be * t / bm) / bm, steady))
         # the lever: the largest shift in standard errors among the variants
         # that are measurements (steady, and inside the coupling's validity)
         valid = not (r["variant"].startswith("sph_") and f(r, "sph_h") > 0 and f(r, "radius") > 0
@@ -110,6 +132,11 @@ def main(argv):
                   + (f"; the base h/d = {base_h[0]:.2f}." if base_h else ".")
                   + " A variant outside the model measures the discretisation, not the physics: its shift is "
                   "not a convergence error of the base."]
+    if bars:
+        lines += ["", "![convergence](convergence.png)", "",
+                  "The figure: each variant's shift of the wall stress from the base, in per cent, with its combined "
+                  "standard error; hollow markers are variants whose own run is not steady."]
+        plot(bars, os.path.join(os.path.dirname(os.path.abspath(out)), "convergence.png"))
     with open(out, "w") as fh:
         fh.write("\n".join(lines) + "\n")
     print(f"-> {out}")
