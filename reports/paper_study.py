@@ -138,7 +138,7 @@ def old_claims(crit, small_crit, phi, small_m):
         lines.append(row("model 1 is 27-68 % below model 3 at every Mn (D_1 in [-0.68, -0.27])", m,
                          sdev.get("dem_stokes", {}).get(m), dev.get("dem_stokes", {}).get(m), -0.68, -0.27))
     for m in [m for m in grid if m <= 1.0]:
-        lines.append(row("models 2 and 3 agree within 10 % up to Mn about 1 (|D_2| <= 0.10)", m,
+        lines.append(row("models 2 and 3 agree within 10 % up to Mn about 1 (abs(D_2) <= 0.10)", m,
                          sdev.get("demsph_stokes", {}).get(m), dev.get("demsph_stokes", {}).get(m), -0.10, 0.10))
     for m in [m for m in grid if 1e-2 <= m <= 1.0]:
         lines.append(row("model 1's volume-side stress is within 11 % of model 3 for 1e-2 <= Mn <= 1 "
