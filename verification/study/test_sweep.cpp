@@ -200,6 +200,16 @@ TEST(Sweep, KilledSweepResumesAndReproduces) {
   cal.calibrate = out.string();
   const auto fresh_out = std::filesystem::temp_directory_path() / "mrf_test_sweep_calibrated";
   std::filesystem::remove_all(fresh_out);
+  // a variant sweep calibrated by a plain one: the same model, Mn and seed
+  const SweepSpec with_variant = parse_sweep(
+      "[sweep]\nscene = \"small_dem_stokes.toml\"\nmodels = [\"dem_stokes\"]\nmason = [1.0]\nseeds = [3]\n"
+      "set = [\"drive.strain=0.6\", \"drive.warmup_strain=0.2\"]\n[[variant]]\nname = \"stiff\"\n"
+      "set = [\"contact.youngs_modulus=4e10\"]\n",
+      "tiny.toml", k_scenes);
+  const PointEstimates by_plain = estimate_points(with_variant, sweep_points(with_variant),
+                                                  (out / "nothing_here").string(), 1e6, "", out.string());
+  ASSERT_TRUE(by_plain.calibrated[0]);
+  EXPECT_DOUBLE_EQ(by_plain.seconds[0], read_json(p1 / "summary.json")["seconds_per_strain"].get<double>() * 0.6);
   const SweepSpec short_one = parse_sweep(
       "[sweep]\nscene = \"small_dem_stokes.toml\"\nmodels = [\"dem_stokes\"]\nmason = [1.0]\nseeds = [3]\n"
       "set = [\"drive.strain=0.6\", \"drive.warmup_strain=0.2\"]\n",

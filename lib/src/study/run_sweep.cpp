@@ -99,10 +99,15 @@ PointEstimates estimate_points(const SweepSpec& spec, const std::vector<SweepPoi
     auto path = std::filesystem::path(out_dir) / points[k].dir / "summary.json";
     const bool own = std::filesystem::exists(path);
     if (!own) {
+      // the calibration folder may be a sweep without this sweep's
+      // variants: the same model, Mn and seed there calibrate too
+      std::string plain = points[k].dir;
+      if (!points[k].variant.empty()) plain.erase(points[k].model.size() + 1, points[k].variant.size() + 1);
       bool found = false;
-      for (const std::string* d : {&archive_dir, &calibrate_dir})
-        if (!found && !d->empty() && std::filesystem::exists(std::filesystem::path(*d) / points[k].dir / "summary.json")) {
-          path = std::filesystem::path(*d) / points[k].dir / "summary.json";
+      for (const auto& [d, rel] : {std::pair{&archive_dir, points[k].dir}, std::pair{&calibrate_dir, points[k].dir},
+                                   std::pair{&calibrate_dir, plain}})
+        if (!found && !d->empty() && std::filesystem::exists(std::filesystem::path(*d) / rel / "summary.json")) {
+          path = std::filesystem::path(*d) / rel / "summary.json";
           found = true;
         }
       if (!found) continue;

@@ -142,7 +142,9 @@ double estimate_point_seconds(const std::string& scene_path, const std::vector<s
 // archive (--archive), its summaries calibrate too, by their seconds per
 // strain unit, where out_dir has none; so do those of calibrate_dir
 // (--calibrate-from: a folder laid out like an archive, read for the cost
-// alone and never restored), where neither has the point.
+// alone and never restored), where neither has the point; for a point of a
+// variant, the same model, Mn and seed without the variant level there
+// calibrates too (a convergence sweep estimated from its base sweep).
 struct PointEstimates {
   std::vector<double> seconds;
   std::vector<char> calibrated;
