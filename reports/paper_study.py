@@ -76,15 +76,18 @@ def two_paths(argv, here, crit, phi, models):
         return []
     fixed = json.load(open(crit_path))  # the seed-combined points, as for the realistic path
     dimless = {}  # St and Re_p of each (model, Mn), from the runs
+    unsteady = defaultdict(int)  # runs failing a steadiness test, per (model, Mn)
     for r in read_rows(path):
         if r["status"] == "ok":
             dimless[(r["model"], float(r["mason"]))] = (num(r, "stokes_number"), num(r, "reynolds_number"))
+            unsteady[(r["model"], float(r["mason"]))] += 0 if steady(r) else 1
     lines = ["## Two paths to a Mason number", "",
              "The realistic path (gdot = 1e3 1/s, M set by Mn: St and Re_p about 1e-4) against a fixed "
              "M = 1 MA/m with Mn set by the shear rate (experiments/sweeps/paper_fixed_m.toml: St = 0.30 Mn, "
              "Re_p = 0.175 Mn). Total wall stress / (phi mu0 M^2), seed-combined by mrf criterion as the "
              "realistic path is; the difference in combined standard errors. Where it is large, the model's "
-             "behaviour at that Mn on the fixed-M path is inertia, not rheology.", "",
+             "behaviour at that Mn on the fixed-M path is inertia, not rheology. Seeds: how many, and in brackets "
+             "how many of them fail a steadiness test (after their one re-run, experiments/sweeps/paper_fixed_m.toml).", "",
              "| model | Mn | seeds (fixed M) | fixed M | St, Re_p | realistic | fixed - realistic (sigma) | "
              "particle part: fixed M | realistic |",
              "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
@@ -103,7 +106,9 @@ def two_paths(argv, here, crit, phi, models):
                         f"{(q['stress'] - q['stress_fluid']) / sr:.4f} ± {re_:.4f}")
             else:
                 cmp_ = f"– | – | {pt:.4f} ± {e:.4f} | –"
-            lines.append(f"| {k} | {f['mason']:g} | {f['seeds']} | {t:.4f} ± {e:.4f} | {st:.2g}, {re:.2g} | {cmp_} |")
+            bad = unsteady.get((k, f["mason"]), 0)
+            seeds = f"{f['seeds']}" + (f" ({bad} unsteady)" if bad else "")
+            lines.append(f"| {k} | {f['mason']:g} | {seeds} | {t:.4f} ± {e:.4f} | {st:.2g}, {re:.2g} | {cmp_} |")
     lines.append("")
     return lines
 
