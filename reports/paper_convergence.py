@@ -65,6 +65,14 @@ def main(argv):
     conv = rows(argv[1])
     base_rows = rows(argv[2] if len(argv) > 2 else os.path.join(here, "study", "paper", "sweep.csv"))
     out = argv[3] if len(argv) > 3 else os.path.join(here, "study", "paper", "convergence.md")
+    radii = [f(x, "radius") for x in base_rows if f(x, "radius") > 0]  # older summaries lack the radius
+    for r in conv:
+        if not f(r, "radius") > 0 and radii:
+            r["radius"] = str(radii[0])
+
+    def h_over_d(r):  # the SPH kernel over the particle diameter; 0 when unknown
+        return f(r, "sph_h") / (2 * f(r, "radius")) if f(r, "sph_h") > 0 and f(r, "radius") > 0 else 0.0
+
     base = defaultdict(list)
     for r in base_rows:
         base[(r["model"], float(r["mason"]))].append(r)
@@ -102,8 +110,7 @@ def main(argv):
         bars.append((key, r["variant"], 100 * (t / bm - 1), 100 * math.hypot(ve, be * t / bm) / bm, steady))
         # the lever: the largest shift in standard errors among the variants
         # that are measurements (steady, and inside the coupling's validity)
-        valid = not (r["variant"].startswith("sph_") and f(r, "sph_h") > 0 and f(r, "radius") > 0
-                     and f(r, "sph_h") / (2 * f(r, "radius")) < 2)
+        valid = not (r["variant"].startswith("sph_") and 0 < h_over_d(r) < 2)
         if steady and valid and abs(z) > lever.get(key, (-1,))[0]:
             lever[key] = (abs(z), r["variant"], t / bm - 1, z, steady)
         lines.append(f"| {r['model']} | {key[1]:g} | {r['variant']} | {t:.5f} ± {ve:.5f} | {bm:.5f} ± {be:.5f} "
@@ -116,14 +123,8 @@ def main(argv):
             lines.append(f"- {k}, Mn {m:g}: {v}, {100 * sh:+.1f} % ({z:+.1f} sigma)")
     # SPH resolution: which spacings the unresolved, locally averaged
     # coupling admits (REFERENCE.md §6: the averaging assumes h >~ 2 d).
-    radii = [f(x, "radius") for x in base_rows if f(x, "radius") > 0]  # older summaries lack the radius
-    for r in conv:  # and the validity test of the lever above needs it
-        if not f(r, "radius") > 0 and radii:
-            r["radius"] = str(radii[0])
-    res = sorted({(r["variant"], f(r, "sph_h") / (2 * (f(r, "radius") if f(r, "radius") > 0 else radii[0])))
-                  for r in conv if r["variant"].startswith("sph_") and f(r, "sph_h") > 0 and radii})
-    base_h = sorted({f(x, "sph_h") / (2 * f(x, "radius")) for x in base_rows
-                     if x["model"] != "dem_stokes" and f(x, "sph_h") == f(x, "sph_h")})
+    res = sorted({(r["variant"], h_over_d(r)) for r in conv if r["variant"].startswith("sph_") and h_over_d(r) > 0})
+    base_h = sorted({h_over_d(x) for x in base_rows if x["model"] != "dem_stokes" and h_over_d(x) > 0})
     if res:
         lines += ["", "SPH resolution against the coupling's validity (REFERENCE.md §6: the local averaging of the "
                   "unresolved coupling assumes a kernel of at least about 2 particle diameters, h/d >~ 2): "

@@ -195,13 +195,9 @@ def old_claims(crit, small_crit, phi, small_m):
     return lines
 
 
-def sweep_cost(rows, first_dir):
+def sweep_cost(rows, firsts):
     """The wall time of the whole sweep: every run that counts, plus the
-    first runs that the steadiness re-runs replaced."""
-    firsts = []
-    for dirpath, _, files in sorted(os.walk(first_dir)) if os.path.isdir(first_dir) else []:
-        if "summary.json" in files:
-            firsts.append(json.load(open(os.path.join(dirpath, "summary.json"))))
+    first runs (summaries) that the steadiness re-runs replaced."""
     per = defaultdict(float)
     for r in rows:
         per[r["model"]] += num(r, "wall_seconds")
@@ -365,7 +361,7 @@ def main(argv):
     lines += ["", "Cost: wall seconds per strain unit of each run, one thread, on a shared 2-core machine "
               "(the sweep ran at nice 19 beside other work: an upper bound, not a benchmark; "
               "reports/performance/model_ratios.md has the side-by-side ratios).", ""]
-    lines += sweep_cost(rows, first_dir)
+    lines += sweep_cost(rows, firsts)
     # cost per strain unit per model and Mn: the fastest seed (the least
     # disturbed by other jobs), and its ratio to model 1's at the same Mn
     per = defaultdict(list)

@@ -19,7 +19,6 @@
 #include "mrf/io/lammps_data.hpp"
 #include "mrf/scene/build_model.hpp"
 #include "mrf/scene/run.hpp"
-#include "mrf/scene/run_series.hpp"
 #include "mrf/study/sweep.hpp"
 #include "mrf/version.hpp"
 
@@ -111,9 +110,7 @@ int sweep_command(const SweepArgs& a) {
                 "estimate (s; * = from the particle-steps model, no point of the model finished)");
     for (const auto& p : points) {
       const std::filesystem::path dir = std::filesystem::path(out) / p.dir;
-      const std::string id = mrf::folder_scene_id(dir);
-      const bool stale = !id.empty() && id != mrf::scene_id(mrf::load_scene(spec.scene_path, p.sets).config);
-      const char* state = stale                                           ? "stale"
+      const char* state = mrf::point_stale(spec, p, dir)                                           ? "stale"
                           : std::filesystem::exists(dir / "summary.json")   ? "finished"
                           : std::filesystem::exists(dir / "failure.json") ? "failed"
                           : std::filesystem::exists(dir / "checkpoint.bin") ? "started"

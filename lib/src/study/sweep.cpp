@@ -15,9 +15,7 @@
 #include "mrf/error.hpp"
 #include "mrf/io/atomic_file.hpp"
 #include "mrf/io/quantity.hpp"
-#include "mrf/io/toml_scene.hpp"
 #include "mrf/scene/config.hpp"
-#include "mrf/scene/run_series.hpp"
 
 namespace mrf {
 namespace {
@@ -290,15 +288,6 @@ bool point_finished(const std::string& point_dir) {
   return std::filesystem::exists(d / "summary.json") || std::filesystem::exists(d / "failure.json");
 }
 
-namespace {
-// a folder made for another scene than the point's as `spec` defines it
-bool stale_folder(const SweepSpec* spec, const SweepPoint& p, const std::filesystem::path& dir) {
-  if (!spec) return false;
-  const std::string have = folder_scene_id(dir);
-  return !have.empty() && have != scene_id(load_scene(spec->scene_path, p.sets).config);
-}
-}  // namespace
-
 std::string sweep_csv(const std::vector<SweepPoint>& points, const std::string& out_dir, const SweepSpec* spec) {
   static const char* numbers[] = {"shear_rate", "strain", "warmup_strain", "stress_total", "stress_total_err",
                                   "stress_total_drift_z", "steady_mser_discard_fraction", "stress_particles", "stress_particles_err", "stress_fluid",
@@ -317,7 +306,7 @@ std::string sweep_csv(const std::vector<SweepPoint>& points, const std::string& 
     const auto dir = std::filesystem::path(out_dir) / p.dir;
     nlohmann::json j;
     std::string status;
-    if (stale_folder(spec, p, dir)) {
+    if (spec && point_stale(*spec, p, dir)) {
       status = "stale";
     } else if (std::ifstream in(dir / "summary.json"); in) {
       j = nlohmann::json::parse(in, nullptr, false);
@@ -345,7 +334,7 @@ std::size_t write_sweep_csv(const std::vector<SweepPoint>& points, const std::st
   std::size_t done = 0;
   for (const auto& p : points) {
     const auto dir = std::filesystem::path(out_dir) / p.dir;
-    done += point_finished(dir.string()) && !stale_folder(spec, p, dir) ? 1 : 0;
+    done += point_finished(dir.string()) && !(spec && point_stale(*spec, p, dir)) ? 1 : 0;
   }
   return done;
 }

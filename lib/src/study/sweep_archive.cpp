@@ -68,6 +68,11 @@ std::string folder_scene_id(const std::filesystem::path& dir) {
   }
 }
 
+bool point_stale(const SweepSpec& spec, const SweepPoint& p, const std::filesystem::path& dir) {
+  const std::string have = folder_scene_id(dir);
+  return !have.empty() && have != scene_id(load_scene(spec.scene_path, p.sets).config);
+}
+
 std::vector<std::string> set_aside_stale(const SweepSpec& spec, const std::vector<SweepPoint>& points,
                                          const std::string& out_dir, bool quiet) {
   std::vector<std::string> moved;

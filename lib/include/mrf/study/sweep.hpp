@@ -189,6 +189,8 @@ void report_archive(const ArchiveSync& sync, const std::string& archive_dir, boo
 // failure.json, or the checkpoint's fingerprint); empty when it cannot be
 // told.
 std::string folder_scene_id(const std::filesystem::path& dir);
+// Whether the folder holds a run made for another scene than the point's.
+bool point_stale(const SweepSpec& spec, const SweepPoint& p, const std::filesystem::path& dir);
 
 // The same rule for the sweep output itself, applied by the process that
 // runs the points (run_sweep for its share, the MPI master for the grid):
