@@ -322,7 +322,14 @@ def main(argv):
             rf = "– (one seed: no scatter)" if math.isnan(ratio) else f"{ratio:.2f}"
             lines.append(f"| {k} | {q['mason']:g} | {q['seeds']} | {t:.4f} ± {ef} | "
                          f"{(q['stress'] - q['stress_fluid']) / s:.4f} ± {ef} | {rf} | {cmp_} |")
+    newer = sum(1 for r in rows if num(r, "error_estimate_version") >= 2)
     lines += ["", f"## Steadiness of every run (drift |z| < {DRIFT_Z:g} and MSER-5 discard < {MSER_MAX:g})", "",
+              f"Error estimate: {newer} of {len(rows)} runs carry the block error widened by the blocks' residual "
+              "correlation, with the drift test on detrended halves (`error_estimate_version` 2, from session 24); "
+              "the others the plain Jonsson level, whose errors are too small and whose drift test flags too often "
+              "when a window holds few correlation times (docs/study.md, \"Error bars with few correlation "
+              "times\": on the 19 runs whose series could be re-analysed, errors 1.0-2.6x larger and 3 of 5 "
+              "drift flags cleared).", "",
               "| model | Mn | seed | strain (warm-up) | drift z | MSER discard | steady | s per strain unit |",
               "|---|---:|---:|---:|---:|---:|---|---:|"]
     for r in sorted(rows, key=lambda r: (ORDER.index(r["model"]), float(r["mason"]), int(r["seed"]))):

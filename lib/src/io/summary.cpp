@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "mrf/observe/block_average.hpp"
 #include "mrf/scene/run.hpp"
 #include "mrf/version.hpp"
 
@@ -28,6 +29,7 @@ std::string summary_json(const RunSummary& s) {
   j["shear_rate"] = s.shear_rate;
   j["strain"] = s.strain;
   j["warmup_strain"] = s.warmup_strain;
+  j["error_estimate_version"] = k_error_estimate_version;
   put("stress_total", s.stress_total);
   put("stress_particles", s.stress_particles);
   j["stress_fluid"] = s.stress_fluid;

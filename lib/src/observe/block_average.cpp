@@ -2,6 +2,7 @@
 
 #include <gsl/gsl_cdf.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numeric>
 
@@ -53,7 +54,40 @@ double blocked_sem(const double* a, std::size_t n) {
       level = j;
       break;
     }
-  return std::sqrt(s2[level] / nk[level]);
+  // With few correlation times in the series the test above passes at a
+  // level whose blocks are still correlated (it has little power with 8-32
+  // blocks), and s_j^2 / n_j is too small. The blocks' own
+  // lag-one correlation r, corrected for its small-sample bias (Kendall
+  // 1954: E r = rho - (1 + 3 rho) / n), is taken as an AR(1) of the blocks,
+  // whose mean's variance is (1 + r) / (1 - r) times the uncorrelated one.
+  // Never below the plain estimate (r >= 0), at most sqrt(19) times it (r <=
+  // 0.9). With it, at 32 / 16 / 8 correlation times per half: the mean
+  // outside two standard errors in 4.7 / 3.7 / 7.3 % of the series, drift
+  // flags 1 / 2.7 / 5 % (before: 17 / 25 / 34 % and 8 / 14 / 18 %;
+  // test_block_average.cpp).
+  double r = s2[level] > 0 ? g[level] / s2[level] : 0.0;
+  r = std::clamp(r + (1.0 + 3.0 * r) / nk[level], 0.0, 0.9);
+  return std::sqrt(s2[level] / nk[level] * (1.0 + r) / (1.0 - r));
+}
+
+// The standard error of each half's mean for the drift test, from the
+// half with its least-squares line removed. A trend within a half reads to
+// the blocking as correlation and, since the correction above, inflates the
+// error that should reveal it: a rise of 3 sigma over a white-noise series
+// gave z = 1.9, and 69 with the line removed (seed 0 of the test). On a
+// stationary series the line removes little: the drift flags above.
+double detrended_sem(const double* a, std::size_t n) {
+  const double tm = 0.5 * static_cast<double>(n - 1), m = mean_of(a, n);
+  double stt = 0, sty = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) - tm;
+    stt += t * t;
+    sty += t * (a[i] - m);
+  }
+  const double slope = stt > 0 ? sty / stt : 0.0;
+  std::vector<double> res(n);
+  for (std::size_t i = 0; i < n; ++i) res[i] = (a[i] - m) - slope * (static_cast<double>(i) - tm);
+  return blocked_sem(res.data(), n);
 }
 
 }  // namespace
@@ -69,7 +103,7 @@ BlockAverage block_average(const std::vector<double>& series) {
     const double* first = series.data();
     const double* second = series.data() + (n - h);
     r.half_difference = mean_of(second, h) - mean_of(first, h);
-    const double e = std::hypot(blocked_sem(first, h), blocked_sem(second, h));
+    const double e = std::hypot(detrended_sem(first, h), detrended_sem(second, h));
     r.drift_z = e > 0 ? r.half_difference / e : 0.0;
   }
   return r;

@@ -296,7 +296,8 @@ std::string sweep_csv(const std::vector<SweepPoint>& points, const std::string& 
                                   "stress_virial_contact", "stress_virial_contact_err", "n_particles", "n_fluid", "dt", "steps", "wall_seconds",
                                   "stokes_number", "reynolds_number", "max_overlap_over_radius", "volume_fraction",
                                   "magnetization", "youngs_modulus", "viscosity", "fluid_density", "gap", "radius",
-                                  "spanning_fraction", "sph_h", "implicit_newton_iterations", "implicit_linear_iterations"};
+                                  "spanning_fraction", "sph_h", "implicit_newton_iterations", "implicit_linear_iterations",
+                                  "error_estimate_version"};
   std::ostringstream csv;
   csv.precision(10);
   csv << "model,mason,seed,status";
