@@ -37,15 +37,15 @@ class FluidResponse final : public MobilityCoupling {
   double coupling(std::size_t i, std::size_t k) const override;
 
  private:
-  // Per DEM particle, per SPH neighbour (images merged): SPH index and
-  // weight W / (rho_a s_j), which scatters a force and, times m, gathers
+  // Per DEM particle, per SPH neighbour (images merged): 4 x SPH index (an
+  // offset into xyz padded to four doubles) and weight W / (rho_a s_j), which scatters a force and, times m, gathers
   // the response, so that an application is two passes of three
   // multiply-adds per entry.
   std::vector<std::uint32_t> a_;
   std::vector<double> scatter_;
   double mass_ = 0;
   std::vector<std::uint32_t> start_;  // pairs of DEM particle i: [start_[i], start_[i + 1])
-  std::vector<std::uint32_t> rstart_, rdem_;  // the entries by SPH particle: DEM index
+  std::vector<std::uint32_t> rstart_, rdem_;  // the entries by SPH particle: 4 x DEM index
   std::vector<double> rscatter_;              // and scatter weight
   std::vector<std::uint32_t> fill_;           // scratch of set(): the next free slot per SPH particle
   std::vector<std::vector<std::uint32_t>> part_a_;  // scratch of set(): the entries of each block of rows but the first
@@ -57,7 +57,7 @@ class FluidResponse final : public MobilityCoupling {
   // scratch of add(), xyz padded to four doubles: the forces, per SPH
   // particle sum_j W_aj f_j / (rho_a s_j), and the gathered response
   std::vector<double> f4_, z4_, y4_;
-  mutable std::vector<double> dense_; // scratch of coupling(): per SPH particle, zero between calls
+  mutable std::vector<double> dense_; // scratch of coupling(): at 4 x SPH index, zero between calls
 };
 
 }  // namespace mrf
