@@ -103,9 +103,8 @@ namespace {
 // load, multiply and add: with a 64-bit running position and the offsets
 // stored ready, about five instructions an entry (seven when the loop
 // recomputed e + k in 32 bits and shifted each index): 333 -> 295 us per
-// product in bench_fluid_response. What is left is mostly reading the
-// 12 bytes of index and weight of each entry from L3 (3.5 MB a pass on the
-// paper cell, beyond the 2 MB L2). Four partial sums per row (entries e, e+1, e+2, e+3 mod 4),
+// product in bench_fluid_response. Not the bytes read: single-precision
+// weights (a third less per entry) took 306 us. Four partial sums per row (entries e, e+1, e+2, e+3 mod 4),
 // added pairwise at the end: one sum alone is a chain of dependent adds,
 // which held the loop to one entry per add latency (perf: 90 % of its
 // samples on the add). The order is fixed by the pairs alone, so the
