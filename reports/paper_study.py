@@ -330,14 +330,16 @@ def main(argv):
               "when a window holds few correlation times (docs/study.md, \"Error bars with few correlation "
               "times\": on the 19 runs whose series could be re-analysed, errors 1.0-2.6x larger and 3 of 5 "
               "drift flags cleared).", "",
-              "| model | Mn | seed | strain (warm-up) | drift z | MSER discard | steady | s per strain unit |",
-              "|---|---:|---:|---:|---:|---:|---|---:|"]
+              "| model | Mn | seed | strain (warm-up) | drift z | MSER discard | steady | independent samples "
+              "(version 2) | s per strain unit |",
+              "|---|---:|---:|---:|---:|---:|---|---:|---:|"]
     for r in sorted(rows, key=lambda r: (ORDER.index(r["model"]), float(r["mason"]), int(r["seed"]))):
         per = num(r, "wall_seconds") / num(r, "strain")
+        ind = num(r, "stress_total_independent_samples")
         lines.append(f"| {r['model']} | {float(r['mason']):g} | {r['seed']} | {num(r, 'strain'):g} "
                      f"({num(r, 'warmup_strain'):g}) | {num(r, 'stress_total_drift_z'):+.2f} | "
                      f"{num(r, 'steady_mser_discard_fraction'):.3f} | {'yes' if steady(r) else '**no**'} | "
-                     f"{per:.3g} |")
+                     f"{'–' if math.isnan(ind) else f'{ind:.0f}'} | {per:.3g} |")
     # The first runs of points re-run for steadiness (their summaries kept
     # in first_runs/ before the re-run overwrote the archive entry).
     first_dir = arg(argv, "--first-runs", os.path.join(here, "study", "paper", "first_runs"))

@@ -74,13 +74,14 @@ TEST(BlockAverage, WhiteNoiseSemIsSigmaOverRootN) {
   constexpr double sigma = 2.0, mu = 5.0;
   constexpr int repeats = 64;
   const double exact = sigma / std::sqrt(static_cast<double>(n));
-  std::vector<double> ratio;
+  std::vector<double> ratio, independent;
   int within = 0;
   for (int s = 0; s < repeats; ++s) {
     const BlockAverage b = block_average(white_noise(n, mu, sigma, 1000 + s));
     EXPECT_EQ(b.samples, static_cast<int>(n));
     EXPECT_LT(std::abs(b.mean - mu), 5 * exact) << "seed " << s;
     ratio.push_back(b.sem / exact);
+    independent.push_back(b.independent_samples / static_cast<double>(n));
     within += std::abs(ratio.back() - 1) < 0.1;
     // Never far below: the finest level alone is accurate to 1 %.
     EXPECT_GT(ratio.back(), 0.95) << "seed " << s;
@@ -88,6 +89,9 @@ TEST(BlockAverage, WhiteNoiseSemIsSigmaOverRootN) {
   EXPECT_NEAR(mean_of(ratio), 1.0, 0.1)
       << "mean sem / (sigma/sqrt(n)) over " << repeats << " series; " << within << " of "
       << repeats << " single series within 10 %";
+  // every sample independent
+  EXPECT_NEAR(mean_of(independent), 1.0, 0.1) << "mean independent_samples / n";
+  RecordProperty("mean_independent_ratio", std::to_string(mean_of(independent)));
 }
 
 TEST(BlockAverage, Ar1SemMatchesTheAsymptoticFormula) {
@@ -96,14 +100,18 @@ TEST(BlockAverage, Ar1SemMatchesTheAsymptoticFormula) {
   constexpr int repeats = 32;
   // Var(mean) = sigma_x^2 (1+rho)/(1-rho)/n up to O(1/n^2) (relative 3e-3 here).
   const double exact = sigma_x * std::sqrt((1 + rho) / (1 - rho) / static_cast<double>(n));
-  std::vector<double> ratio;
+  std::vector<double> ratio, independent;
   for (int s = 0; s < repeats; ++s) {
     const BlockAverage b = block_average(ar1(n, rho, sigma_x, 2000 + s));
     ratio.push_back(b.sem / exact);
+    // n (1 - rho) / (1 + rho) = n / 19 independent samples
+    independent.push_back(b.independent_samples * (1 + rho) / ((1 - rho) * static_cast<double>(n)));
     EXPECT_GT(ratio.back(), 0.75) << "seed " << s;
     EXPECT_LT(ratio.back(), 2.0) << "seed " << s;
   }
   EXPECT_NEAR(mean_of(ratio), 1.0, 0.2) << "mean sem / exact over " << repeats << " series";
+  EXPECT_NEAR(mean_of(independent), 1.0, 0.2) << "mean independent_samples / (n (1 - rho) / (1 + rho))";
+  RecordProperty("mean_independent_ratio", std::to_string(mean_of(independent)));
   RecordProperty("mean_ratio", std::to_string(mean_of(ratio)));
   // The naive (uncorrelated) estimate would be too small by sqrt(19).
   const BlockAverage one = block_average(ar1(n, rho, sigma_x, 7));
@@ -120,6 +128,7 @@ TEST(BlockAverage, ConstantSeriesHasExactMeanAndZeroSem) {
           << where << ": mean - c = " << b.mean - c << ", sem = " << b.sem;
       EXPECT_EQ(b.half_difference, 0.0) << where;
       EXPECT_EQ(b.drift_z, 0.0) << where;
+      EXPECT_EQ(b.independent_samples, 0.0) << where;
     }
 }
 

@@ -14,6 +14,7 @@ std::string summary_json(const RunSummary& s) {
     j[key] = m.mean;
     j[key + "_err"] = m.err;
     j[key + "_drift_z"] = m.drift_z;
+    j[key + "_independent_samples"] = m.independent_samples;
   };
   j["model"] = s.model;
   // JSON has no infinity: Mn is infinite at magnetization 0 (drive.shear_rate

@@ -98,6 +98,11 @@ BlockAverage block_average(const std::vector<double>& series) {
   r.samples = static_cast<int>(n);
   r.mean = mean_of(series.data(), n);
   r.sem = blocked_sem(series.data(), n);
+  if (r.sem > 0) {
+    double v = 0;
+    for (const double x : series) v += (x - r.mean) * (x - r.mean);
+    r.independent_samples = v / static_cast<double>(n) / (r.sem * r.sem);
+  }
   const std::size_t h = n / 2;
   if (h >= 8) {
     const double* first = series.data();

@@ -27,7 +27,7 @@ namespace {
 
 Measurement measure(const std::vector<double>& v) {
   const BlockAverage b = block_average(v);
-  return {b.mean, b.sem, b.drift_z};
+  return {b.mean, b.sem, b.drift_z, b.independent_samples};
 }
 
 }  // namespace

@@ -11,6 +11,10 @@ struct BlockAverage {
   double sem = 0;        // standard error of the mean, automatic blocking (Jonsson 2018), widened
                          // by the residual correlation of the chosen blocks (block_average.cpp)
   int samples = 0;
+  // Var(x) / sem^2: how many independent samples the series is worth (the
+  // samples over the statistical inefficiency); few (tens) mean the error
+  // and the drift test rest on few correlation times. 0 for a constant series.
+  double independent_samples = 0;
   double half_difference = 0;  // mean(second half) - mean(first half)
   double drift_z = 0;          // half_difference / its standard error; |z| > 3 flags drift
 };

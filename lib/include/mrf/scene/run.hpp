@@ -33,7 +33,7 @@ struct RunInterrupted : std::runtime_error {
 };
 
 struct Measurement {
-  double mean = 0, err = 0, drift_z = 0;
+  double mean = 0, err = 0, drift_z = 0, independent_samples = 0;
 };
 
 struct RunSummary {
