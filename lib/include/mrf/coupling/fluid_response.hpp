@@ -38,9 +38,9 @@ class FluidResponse final : public MobilityCoupling {
 
  private:
   // Per DEM particle, per SPH neighbour (images merged): 4 x SPH index (an
-  // offset into xyz padded to four doubles) and weight W / (rho_a s_j), which scatters a force and, times m, gathers
-  // the response, so that an application is two passes of three
-  // multiply-adds per entry.
+  // offset into xyz padded to four doubles) and weight W / (rho_a s_j),
+  // which scatters a force and, times m, gathers the response, so that an
+  // application is two passes of three multiply-adds per entry.
   std::vector<std::uint32_t> a_;
   std::vector<double> scatter_;
   double mass_ = 0;

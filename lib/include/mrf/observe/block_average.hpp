@@ -16,7 +16,8 @@ struct BlockAverage {
   // and the drift test rest on few correlation times. 0 for a constant series.
   double independent_samples = 0;
   double half_difference = 0;  // mean(second half) - mean(first half)
-  double drift_z = 0;          // half_difference / its standard error; |z| > 3 flags drift
+  double drift_z = 0;          // half_difference / its standard error (each half's from the half with
+                               // its least-squares line removed); |z| > 3 flags drift
 };
 
 BlockAverage block_average(const std::vector<double>& series);
