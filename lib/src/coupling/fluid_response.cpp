@@ -105,9 +105,9 @@ namespace {
 // recomputed e + k in 32 bits and shifted each index): 333 -> 295 us per
 // product in bench_fluid_response. Not the bytes read: single-precision
 // weights (a third less per entry) took 306 us. Four partial sums per row
-// (entries e, e+1, e+2, e+3 mod 4), added pairwise at the end: one sum alone is a chain of dependent adds,
-// which held the loop to one entry per add latency (perf: 90 % of its
-// samples on the add). The order is fixed by the pairs alone, so the
+// (entries e, e+1, e+2, e+3 mod 4), added pairwise at the end: one sum
+// alone is a chain of dependent adds, which held the loop to one entry per
+// add latency (perf: 90 % of its samples on the add). The order is fixed by the pairs alone, so the
 // result does not depend on the thread count (-ffp-contract=off under
 // -std=c++20 keeps the products unfused). Cloned for AVX2 and the
 // baseline, chosen when the program loads.
