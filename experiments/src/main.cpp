@@ -17,6 +17,7 @@
 #include "quasistatic_command.hpp"
 #include "mrf/error.hpp"
 #include "mrf/io/lammps_data.hpp"
+#include "mrf/io/timeseries.hpp"
 #include "mrf/scene/build_model.hpp"
 #include "mrf/scene/run.hpp"
 #include "mrf/study/sweep.hpp"
@@ -248,8 +249,17 @@ int main(int argc, char** argv) {
   qs->add_option("--checkpoint-every", qs_cli.checkpoint_seconds,
                  "wall seconds between checkpoints and partial CSVs (0 = only at the end)")
       ->capture_default_str();
+  auto* ra = app.add_subcommand("reanalyse",
+                                "a finished run's statistics (wall stress, pair virial) re-estimated from its "
+                                "timeseries.csv by this version's block averaging, beside what its summary.json holds");
+  std::vector<std::string> ra_dirs;
+  ra->add_option("dirs", ra_dirs, "run directories (summary.json + timeseries.csv)")->required();
   CLI11_PARSE(app, argc, argv);
   try {
+    if (*ra) {
+      for (const auto& d : ra_dirs) std::printf("%s\n", mrf::reanalyse_run(d).c_str());
+      return 0;
+    }
     if (*run) return run_command(scene, sets, out, quiet, resume, checkpoint_seconds);
     if (*exp) return export_lammps(exp_scene, exp_sets, exp_out);
     if (*cr) return criterion_command(cr_path, cr_thresholds);

@@ -1,0 +1,39 @@
+// A run's timeseries.csv read back, and the averaging window the run took
+// from it: for re-estimating a finished run's statistics with the current
+// block_average (`mrf reanalyse`) when the estimator has changed since.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "mrf/observe/block_average.hpp"
+
+namespace mrf {
+
+struct TimeSeriesTable {
+  std::vector<std::string> names;               // the header's columns
+  std::vector<std::vector<double>> columns;     // per column, one value per row
+  // the column of that name; throws InputError naming the file's columns if absent
+  const std::vector<double>& column(const std::string& name) const;
+  std::string path;
+};
+
+// Throws InputError (file and line) on a row with another number of fields
+// than the header or a field that is not a number.
+TimeSeriesTable read_timeseries(const std::string& path);
+
+// The rows the run averaged (run.cpp): those that start at or after the
+// warm-up, a row starting where the one before it ended (strain 0 for the
+// first). The strain column is written to 10 significant digits, so a row
+// that starts within 1e-9 of the warm-up's end may be taken where the run
+// did not take it.
+std::vector<double> averaging_window(const TimeSeriesTable& t, const std::string& column, double warmup_strain);
+
+// The statistics of the named measurements of a finished run (directory
+// with summary.json and timeseries.csv) by the current estimator, as JSON:
+// per measurement mean, err, drift_z, independent_samples, and beside
+// them what summary.json holds (`stored_*`, and the summary's
+// error_estimate_version, 1 when absent). Measurements: stress_total,
+// stress_particles, stress_virial (magnetic + contact).
+std::string reanalyse_run(const std::string& dir);
+
+}  // namespace mrf

@@ -1,0 +1,109 @@
+#include "mrf/io/timeseries.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cerrno>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "mrf/error.hpp"
+
+namespace mrf {
+
+namespace {
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream s(line);
+  std::string field;
+  while (std::getline(s, field, ',')) out.push_back(field);
+  if (!line.empty() && line.back() == ',') out.emplace_back();
+  return out;
+}
+}  // namespace
+
+const std::vector<double>& TimeSeriesTable::column(const std::string& name) const {
+  for (std::size_t k = 0; k < names.size(); ++k)
+    if (names[k] == name) return columns[k];
+  std::string have;
+  for (const auto& n : names) have += (have.empty() ? "" : ", ") + n;
+  throw InputError("column", name, path, "not in the time series (its columns: " + have + ")");
+}
+
+TimeSeriesTable read_timeseries(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError("file", path, "", "cannot open the time series");
+  TimeSeriesTable t;
+  t.path = path;
+  std::string line;
+  if (!std::getline(in, line)) throw InputError("file", path, "", "empty time series (no header)");
+  t.names = split(line);
+  t.columns.resize(t.names.size());
+  for (long n = 2; std::getline(in, line); ++n) {
+    if (line.empty()) continue;
+    const std::vector<std::string> f = split(line);
+    const std::string where = path + ":" + std::to_string(n);
+    if (f.size() != t.names.size())
+      throw InputError("row", std::to_string(f.size()) + " fields", where,
+                       "the header has " + std::to_string(t.names.size()));
+    for (std::size_t k = 0; k < f.size(); ++k) {
+      char* end = nullptr;
+      errno = 0;
+      const double v = std::strtod(f[k].c_str(), &end);
+      if (f[k].empty() || *end != '\0' || errno == ERANGE)
+        throw InputError(t.names[k], f[k], where, "not a number");
+      t.columns[k].push_back(v);
+    }
+  }
+  return t;
+}
+
+std::vector<double> averaging_window(const TimeSeriesTable& t, const std::string& column, double warmup_strain) {
+  const std::vector<double>& strain = t.column("strain");
+  const std::vector<double>& v = t.column(column);
+  std::vector<double> out;
+  for (std::size_t r = 0; r < v.size(); ++r) {
+    const double start = r == 0 ? 0.0 : strain[r - 1];
+    if (start >= warmup_strain * (1 - 1e-12)) out.push_back(v[r]);
+  }
+  return out;
+}
+
+std::string reanalyse_run(const std::string& dir) {
+  const std::filesystem::path d(dir);
+  std::ifstream in(d / "summary.json");
+  if (!in) throw InputError("directory", dir, "", "no summary.json: not a finished run");
+  const nlohmann::json s = nlohmann::json::parse(in, nullptr, false);
+  if (s.is_discarded() || !s.contains("warmup_strain") || !s["warmup_strain"].is_number())
+    throw InputError("summary.json", (d / "summary.json").string(), "", "unreadable or without warmup_strain");
+  const TimeSeriesTable t = read_timeseries((d / "timeseries.csv").string());
+  const double warmup = s["warmup_strain"].get<double>();
+  nlohmann::ordered_json out;
+  out["dir"] = dir;
+  out["error_estimate_version"] = k_error_estimate_version;
+  out["stored_error_estimate_version"] = s.value("error_estimate_version", 1);
+  auto put = [&](const std::string& key, const std::vector<double>& w) {
+    const BlockAverage b = block_average(w);
+    nlohmann::ordered_json m;
+    m["samples"] = b.samples;
+    m["mean"] = b.mean;
+    m["err"] = b.sem;
+    m["drift_z"] = b.drift_z;
+    m["independent_samples"] = b.independent_samples;
+    for (const char* suffix : {"", "_err", "_drift_z"}) {
+      const std::string k = key + suffix;
+      if (s.contains(k) && s[k].is_number()) m[std::string("stored") + (*suffix ? suffix : "_mean")] = s[k];
+    }
+    out[key] = m;
+  };
+  put("stress_total", averaging_window(t, "stress_total_Pa", warmup));
+  put("stress_particles", averaging_window(t, "stress_particles_Pa", warmup));
+  std::vector<double> vir = averaging_window(t, "stress_virial_magnetic_Pa", warmup);
+  const std::vector<double> con = averaging_window(t, "stress_virial_contact_Pa", warmup);
+  for (std::size_t r = 0; r < vir.size(); ++r) vir[r] += con[r];
+  put("stress_virial", vir);
+  return out.dump(2);
+}
+
+}  // namespace mrf
