@@ -6,22 +6,11 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include "mrf/error.hpp"
+#include "mrf/io/csv.hpp"
 
 namespace mrf {
-
-namespace {
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream s(line);
-  std::string field;
-  while (std::getline(s, field, ',')) out.push_back(field);
-  if (!line.empty() && line.back() == ',') out.emplace_back();
-  return out;
-}
-}  // namespace
 
 const std::vector<double>& TimeSeriesTable::column(const std::string& name) const {
   for (std::size_t k = 0; k < names.size(); ++k)
@@ -38,11 +27,11 @@ TimeSeriesTable read_timeseries(const std::string& path) {
   t.path = path;
   std::string line;
   if (!std::getline(in, line)) throw InputError("file", path, "", "empty time series (no header)");
-  t.names = split(line);
+  t.names = split_csv_line(line);
   t.columns.resize(t.names.size());
   for (long n = 2; std::getline(in, line); ++n) {
     if (line.empty()) continue;
-    const std::vector<std::string> f = split(line);
+    const std::vector<std::string> f = split_csv_line(line);
     const std::string where = path + ":" + std::to_string(n);
     if (f.size() != t.names.size())
       throw InputError("row", std::to_string(f.size()) + " fields", where,

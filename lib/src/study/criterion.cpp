@@ -9,26 +9,16 @@
 
 #include "mrf/coupling/drag_laws.hpp"
 #include "mrf/error.hpp"
+#include "mrf/io/csv.hpp"
 
 namespace mrf {
-
-namespace {
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream ss(line);
-  std::string cell;
-  while (std::getline(ss, cell, ',')) out.push_back(cell);
-  if (!line.empty() && line.back() == ',') out.emplace_back();
-  return out;
-}
-}  // namespace
 
 SweepTable read_sweep_csv(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw InputError("sweep.csv", path, "", "cannot open");
   std::string line;
   std::getline(in, line);
-  const auto header = split(line);
+  const auto header = split_csv_line(line);
   std::map<std::string, std::size_t> col;
   for (std::size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
   for (const char* k : {"model", "mason", "seed", "status", "stress_total", "stress_total_err", "stress_fluid",
@@ -41,7 +31,7 @@ SweepTable read_sweep_csv(const std::string& path) {
   bool first_row = true;
   while (std::getline(in, line)) {
     ++line_no;
-    const auto c = split(line);
+    const auto c = split_csv_line(line);
     if (c.size() != header.size())
       throw InputError("sweep.csv", path + ":" + std::to_string(line_no), "", "row has a different column count");
     if (c[col["status"]] != "ok") continue;
