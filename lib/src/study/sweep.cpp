@@ -297,7 +297,8 @@ std::string sweep_csv(const std::vector<SweepPoint>& points, const std::string& 
                                   "stokes_number", "reynolds_number", "max_overlap_over_radius", "volume_fraction",
                                   "magnetization", "youngs_modulus", "viscosity", "fluid_density", "gap", "radius",
                                   "spanning_fraction", "sph_h", "implicit_newton_iterations", "implicit_linear_iterations",
-                                  "error_estimate_version", "stress_total_independent_samples"};
+                                  "error_estimate_version", "stress_total_independent_samples",
+                                  "stress_particles_drift_z", "stress_particles_independent_samples"};
   std::ostringstream csv;
   csv.precision(10);
   csv << "model,mason,seed,status";
