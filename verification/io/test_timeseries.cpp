@@ -28,6 +28,7 @@ TEST(TimeSeries, ReanalysingAFreshRunGivesItsSummary) {
                                  opt);
   const nlohmann::json r = nlohmann::json::parse(reanalyse_run(dir.string()));
   EXPECT_EQ(r["stored_error_estimate_version"].get<int>(), k_error_estimate_version);
+  EXPECT_EQ(r["steady_mser_discard_fraction"].get<double>(), s.extra.at("steady_mser_discard_fraction"));
   struct Case {
     const char* key;
     Measurement m;

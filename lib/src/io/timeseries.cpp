@@ -9,6 +9,7 @@
 
 #include "mrf/error.hpp"
 #include "mrf/io/csv.hpp"
+#include "mrf/observe/steady_state.hpp"
 
 namespace mrf {
 
@@ -86,7 +87,12 @@ std::string reanalyse_run(const std::string& dir) {
     }
     out[key] = m;
   };
-  put("stress_total", averaging_window(t, "stress_total_Pa", warmup));
+  const std::vector<double> total = averaging_window(t, "stress_total_Pa", warmup);
+  put("stress_total", total);
+  // the policy's second steadiness test, on the total as in the run
+  out["steady_mser_discard_fraction"] =
+      total.empty() ? 0.0 : static_cast<double>(mser_truncation(total)) / static_cast<double>(total.size());
+  if (s.contains("steady_mser_discard_fraction")) out["stored_steady_mser_discard_fraction"] = s["steady_mser_discard_fraction"];
   put("stress_particles", averaging_window(t, "stress_particles_Pa", warmup));
   std::vector<double> vir = averaging_window(t, "stress_virial_magnetic_Pa", warmup);
   const std::vector<double> con = averaging_window(t, "stress_virial_contact_Pa", warmup);

@@ -33,7 +33,8 @@ std::vector<double> averaging_window(const TimeSeriesTable& t, const std::string
 // per measurement mean, err, drift_z, independent_samples, and beside
 // them what summary.json holds (`stored_*`, and the summary's
 // error_estimate_version, 1 when absent). Measurements: stress_total,
-// stress_particles, stress_virial (magnetic + contact).
+// stress_particles, stress_virial (magnetic + contact); and the MSER-5
+// discard fraction of the total, the policy's other steadiness test.
 std::string reanalyse_run(const std::string& dir);
 
 }  // namespace mrf
