@@ -55,6 +55,13 @@ from study import (CHAIN_YIELD, COLOR, LABEL, MN_CONVENTION, MU0, ORDER, experim
                    num, read_rows, save)
 
 DRIFT_Z, MSER_MAX = 3.0, 0.2  # steadiness tests of every point (DESIGN.md, issue 13)
+# The particle-part rule, fixed in session 25 before any window it judges had
+# been run (docs/study.md, "The particle part's rule"): a run's particle part
+# is a measurement only if its drift |z| < 3 and both it and the total are
+# worth at least MIN_INDEPENDENT independent samples (below 16 the drift test
+# of a stationary AR(1) series flags > 10x its nominal rate). It needs the
+# widened estimate (error_estimate_version 2); older runs are "untested".
+MIN_INDEPENDENT = 16
 
 
 def arg(argv, key, default):
@@ -64,6 +71,49 @@ def arg(argv, key, default):
 def steady(r):
     z, d = num(r, "stress_total_drift_z"), num(r, "steady_mser_discard_fraction")
     return abs(z) < DRIFT_Z and d < MSER_MAX
+
+
+def particle_rule(r):
+    """'ok', 'untested' (a summary without the version-2 estimate) or the
+    reasons the run's particle part fails the session-25 rule."""
+    if not num(r, "error_estimate_version") >= 2:
+        return "untested"
+    pz = num(r, "stress_particles_drift_z")
+    pind, tind = num(r, "stress_particles_independent_samples"), num(r, "stress_total_independent_samples")
+    why = []
+    if not abs(pz) < DRIFT_Z:
+        why.append(f"particle drift z {pz:+.1f}")
+    if not pind >= MIN_INDEPENDENT:
+        why.append(f"particle part {pind:.0f} samples")
+    if not tind >= MIN_INDEPENDENT:
+        why.append(f"total {tind:.0f} samples")
+    return "; ".join(why) if why else "ok"
+
+
+def mkey(mn):
+    """A Mason number as a dictionary key that sweep.csv and criterion.json agree on."""
+    return float(f"{float(mn):.6g}")
+
+
+def particle_state(rows):
+    """Per (model, Mn): how many runs' particle parts fail the rule, how many
+    are untested, how many runs."""
+    st = defaultdict(lambda: [0, 0, 0])
+    for r in rows:
+        v = particle_rule(r)
+        c = st[(r["model"], mkey(r["mason"]))]
+        c[0] += v not in ("ok", "untested")
+        c[1] += v == "untested"
+        c[2] += 1
+    return st
+
+
+def particle_note(c):
+    """The particle-part column's qualifier for a point: '' when every run
+    passes the rule."""
+    if not c or (c[0] == 0 and c[1] == 0):
+        return ""
+    return " (" + ", ".join(x for x in (f"{c[0]} fail" if c[0] else "", f"{c[1]} untested" if c[1] else "") if x) + ")"
 
 
 def two_paths(argv, here, crit, phi, models):
@@ -113,7 +163,7 @@ def two_paths(argv, here, crit, phi, models):
     return lines
 
 
-def old_claims(crit, small_crit, phi, small_m):
+def old_claims(crit, small_crit, phi, small_m, pstate=None):
     """The small-cell study's claims (reports/study/study.md, the claims that
     issue 13 names) against the same quantities on the paper cell. A claim
     holds at a point when the paper-cell value lies within the claimed range
@@ -160,14 +210,21 @@ def old_claims(crit, small_crit, phi, small_m):
               "standard errors of 0)? The total's slope is then the carrier's viscous stress (eta gdot, in these "
               "units proportional to Mn); the flat particle stress is not the quasi-static value (the AQS section "
               "below).", "",
+              "In brackets after the paper cell's particle slope: how many of the two points' runs fail the "
+              "particle-part rule (steadiness section) or predate it (untested); a slope from failing runs is "
+              "not a measurement.", "",
               "| model | cell | Mn pair | s (total) | s (particle part) | Delta (fit) | particle part flat |",
               "|---|---|---|---:|---:|---:|---|"]
 
-    def slopes(c, k, scale):
+    def slopes(c, k, scale, states=None):
         p = sorted(c["models"].get(k, {}).get("points", []), key=lambda q: q["mason"])
         if len(p) < 2:
             return None
         a, b = p[0], p[1]
+        note = ""
+        if states is not None:
+            sa, sb = states.get((k, mkey(a["mason"]))), states.get((k, mkey(b["mason"])))
+            note = particle_note([x + y for x, y in zip(sa or [0, 0, 0], sb or [0, 0, 0])])
         out = [f"{a['mason']:g}-{b['mason']:g}"]
         flat = "–"
         for part in (lambda q: q["stress"], lambda q: q["stress"] - q["stress_fluid"]):
@@ -181,14 +238,16 @@ def old_claims(crit, small_crit, phi, small_m):
             sl, se = math.log(vb / va) / lr, math.hypot(ea / va, eb / vb) / lr
             out.append(f"{sl:+.2f} ± {se:.2f}")
             flat = "yes" if abs(sl) <= 2 * se else "no"  # the last part: the particle part
+        out[-1] += note
         pw = c["models"][k].get("power_law", {})
         out.append(f"{pw.get('exponent', float('nan')):.2f} ± {pw.get('exponent_err', float('nan')):.2f}")
         return out + [flat]
 
     for k in [m for m in ORDER if m in crit["models"]]:
-        for name, c, scale in (("paper", crit, lambda q: phi * MU0 * q["magnetization"] ** 2),
-                               ("small", small_crit, lambda q: small_crit["volume_fraction"] * MU0 * small_m ** 2)):
-            s = slopes(c, k, scale)
+        for name, c, scale, states in (("paper", crit, lambda q: phi * MU0 * q["magnetization"] ** 2, pstate),
+                                       ("small", small_crit,
+                                        lambda q: small_crit["volume_fraction"] * MU0 * small_m ** 2, None)):
+            s = slopes(c, k, scale, states)
             if s:
                 lines.append(f"| {k} | {name} | " + " | ".join(s) + " |")
     lines.append("")
@@ -306,6 +365,7 @@ def main(argv):
               "(375 spheres, fixed M = 1e6 A/m), same Mn; difference in combined standard errors.", "",
               "| model | Mn | seeds | total | particle part | seed scatter / within-run | small cell total | "
               "paper - small (sigma) |", "|---|---:|---:|---:|---:|---:|---:|---:|"]
+    pstate = particle_state(rows)
     for k in models:
         for q in crit["models"][k]["points"]:
             s = phi * MU0 * q["magnetization"] ** 2
@@ -321,7 +381,8 @@ def main(argv):
             ef = f"{e:.4f}" if e >= 1e-4 else f"{e:.1e}"
             rf = "– (one seed: no scatter)" if math.isnan(ratio) else f"{ratio:.2f}"
             lines.append(f"| {k} | {q['mason']:g} | {q['seeds']} | {t:.4f} ± {ef} | "
-                         f"{(q['stress'] - q['stress_fluid']) / s:.4f} ± {ef} | {rf} | {cmp_} |")
+                         f"{(q['stress'] - q['stress_fluid']) / s:.4f} ± {ef}{particle_note(pstate.get((k, mkey(q['mason']))))} | "
+                         f"{rf} | {cmp_} |")
     newer = sum(1 for r in rows if num(r, "error_estimate_version") >= 2)
     lines += ["", f"## Steadiness of every run (drift |z| < {DRIFT_Z:g} and MSER-5 discard < {MSER_MAX:g})", "",
               f"Error estimate: {newer} of {len(rows)} runs carry the block error widened by the blocks' residual "
@@ -332,20 +393,27 @@ def main(argv):
               "drift flags cleared).", "",
               "The steadiness tests are on the total stress, which the fluid part dominates above Mn 1e-2; the "
               "particle part, the magnetic effect, can still be moving while the total passes: its drift z is "
-              "listed beside (not a test of the policy; '**' marks |z| > 3).", "",
+              "listed beside ('**' marks |z| > 3). Since session 25 a run's particle part counts as a measurement "
+              f"only if it passes the particle-part rule: its drift |z| < {DRIFT_Z:g} and at least "
+              f"{MIN_INDEPENDENT} independent samples in the window for it and for the total (docs/study.md, "
+              "\"The particle part's rule\", fixed before any window it judges was run). It needs the version-2 "
+              "estimate: older runs are 'untested'. A failing particle part is marked in the stress table and the "
+              "slopes; the run's total keeps the policy above (the rule triggers no re-run).", "",
               "| model | Mn | seed | strain (warm-up) | drift z | MSER discard | steady | independent samples "
-              "(version 2) | particle part: drift z, independent samples | s per strain unit |",
-              "|---|---:|---:|---:|---:|---:|---|---:|---:|---:|"]
+              "(version 2) | particle part: drift z, independent samples | particle-part rule | s per strain unit |",
+              "|---|---:|---:|---:|---:|---:|---|---:|---:|---|---:|"]
     for r in sorted(rows, key=lambda r: (ORDER.index(r["model"]), float(r["mason"]), int(r["seed"]))):
         per = num(r, "wall_seconds") / num(r, "strain")
         ind = num(r, "stress_total_independent_samples")
         pz, pind = num(r, "stress_particles_drift_z"), num(r, "stress_particles_independent_samples")
         pzs = "–" if math.isnan(pz) else (f"**{pz:+.2f}**" if abs(pz) > DRIFT_Z else f"{pz:+.2f}")
         pcol = pzs + ("" if math.isnan(pind) else f", {pind:.0f}")
+        pr = particle_rule(r)
+        pr = pr if pr in ("ok", "untested") else f"**{pr}**"
         lines.append(f"| {r['model']} | {float(r['mason']):g} | {r['seed']} | {num(r, 'strain'):g} "
                      f"({num(r, 'warmup_strain'):g}) | {num(r, 'stress_total_drift_z'):+.2f} | "
                      f"{num(r, 'steady_mser_discard_fraction'):.3f} | {'yes' if steady(r) else '**no**'} | "
-                     f"{'–' if math.isnan(ind) else f'{ind:.0f}'} | {pcol} | {per:.3g} |")
+                     f"{'–' if math.isnan(ind) else f'{ind:.0f}'} | {pcol} | {pr} | {per:.3g} |")
     # The first runs of points re-run for steadiness (their summaries kept
     # in first_runs/ before the re-run overwrote the archive entry).
     first_dir = arg(argv, "--first-runs", os.path.join(here, "study", "paper", "first_runs"))
@@ -494,7 +562,7 @@ def main(argv):
     lines.append("")
     small_crit_path = arg(argv, "--small-criterion", os.path.join(here, "study", "criterion_default.json"))
     small_crit = json.load(open(small_crit_path)) if os.path.exists(small_crit_path) else None
-    lines += old_claims(crit, small_crit, phi, small_m)
+    lines += old_claims(crit, small_crit, phi, small_m, particle_state(rows))
     lines += two_paths(argv, here, crit, phi, models)
     with open(os.path.join(out, "paper.md"), "w") as f:
         f.write("\n".join(lines) + "\n")

@@ -29,7 +29,18 @@ MODELS = {"dem_stokes": (0.006, 1.0), "demsph_stokes": (0.011, 1.25), "demsph_dd
 COLUMNS = ["model", "mason", "seed", "status", "shear_rate", "strain", "warmup_strain", "stress_total",
            "stress_total_err", "stress_total_drift_z", "steady_mser_discard_fraction", "stress_fluid",
            "stress_virial_total", "n_particles", "wall_seconds", "stokes_number", "reynolds_number", "magnetization",
-           "volume_fraction", "viscosity", "fluid_density", "gap", "radius"]
+           "volume_fraction", "viscosity", "fluid_density", "gap", "radius", "error_estimate_version",
+           "stress_total_independent_samples", "stress_particles_drift_z", "stress_particles_independent_samples"]
+# The particle-part rule (reports/paper_study.py): which runs carry the
+# version-2 estimate and how each fares. (model, Mn, seed) -> (version, total
+# samples, particle drift z, particle samples, the verdict the report must give)
+RULE = {("demsph_dd", 1e-3, 1): (2, 40, 3.5, 40, "particle drift z +3.5"),
+        ("demsph_dd", 1e-3, 2): (2, 40, -2.9, 15, "particle part 15 samples"),
+        ("demsph_dd", 1e-3, 3): (2, 12, 0.0, 30, "total 12 samples"),
+        ("demsph_dd", 1e-2, 1): (2, 16, -2.99, 16, "ok"),
+        ("demsph_dd", 1e-2, 2): (2, 16, 0.0, 16, "ok"),
+        ("demsph_dd", 1e-2, 3): (2, 16, 0.0, 16, "ok")}
+# every other run: version 1 (untested)
 
 
 def total(k, mn):
@@ -52,9 +63,10 @@ def main(argv):
                 tau = total(k, mn) * scale
                 for seed in (1, 2, 3):
                     # the same stress for every seed (no scatter), 0.5 % within-run error
+                    v, tind, pz, pind, _ = RULE.get((k, mn, seed), (1, "", 0.5, "", "untested"))
                     w.writerow([k, mn, seed, "ok", GDOT, 30, 8, repr(tau), repr(0.005 * tau), 0.1, 0.0,
                                 repr(e * ETA * GDOT), repr(tau), 4125, 100.0, 1e-4, 6e-5, repr(m), PHI, ETA, 1000.0,
-                                1.5e-4, 2.5e-6])
+                                1.5e-4, 2.5e-6, v, tind, pz, pind])
     subprocess.run([mrf, "criterion", sweep], check=True, stdout=subprocess.DEVNULL)
     out = os.path.join(work, "report")
     none = os.path.join(work, "absent")
@@ -111,6 +123,27 @@ def main(argv):
     verdicts = {line.split("|")[-2].strip() for line in claims}
     if verdicts != {"yes", "**no**"}:
         failures.append(f"the synthetic design should give both verdicts, got {verdicts}")
+    # The particle-part rule: each run's verdict in the steadiness table, and
+    # the counts it leaves on the stress table and the slopes.
+    steady_rows = md.split("## Steadiness of every run")[1].split("\n\n## ")[0].splitlines()
+    for k in MODELS:
+        for mn in GRID:
+            for seed in (1, 2, 3):
+                want = RULE.get((k, mn, seed), (0, 0, 0, 0, "untested"))[4]
+                want = want if want in ("ok", "untested") else f"**{want}**"
+                hit = [x for x in steady_rows if x.startswith(f"| {k} | {mn:g} | {seed} |")]
+                got = [x.strip() for x in hit[0].strip("|").split("|")][9] if hit else None
+                if got != want:
+                    failures.append(f"particle-part rule for {k} Mn {mn:g} seed {seed}: got {got}, want {want}")
+    stress_rows = md.split("## Stress per point")[1].split("\n\n## ")[0].splitlines()
+    for mn, want in ((1e-3, "(3 fail)"), (1e-2, ""), (0.1, "(3 untested)")):
+        hit = [x for x in stress_rows if x.startswith(f"| demsph_dd | {mn:g} | ")]
+        cell = [x.strip() for x in hit[0].strip("|").split("|")][4] if hit else ""
+        if not hit or (want and not cell.endswith(want)) or (not want and cell.endswith(")")):
+            failures.append(f"stress table, demsph_dd Mn {mn:g}: particle part '{cell}', want it to end with '{want}'")
+    slope = [x for x in md.splitlines() if x.startswith("| demsph_dd | paper | ")]
+    if not slope or not [x.strip() for x in slope[0].strip("|").split("|")][4].endswith("(3 fail)"):
+        failures.append(f"the demsph_dd particle slope should carry '(3 fail)': {slope}")
     for f in failures:
         print("FAIL:", f)
     print(f"paper report check: {len(failures)} failure(s)")
