@@ -24,8 +24,10 @@ namespace {
 // but no more than 0.5 (chains lower eps locally during a run; at phi = 0.3
 // and a kernel of >= 2d the SPH-scale porosity stays above it).
 constexpr double k_design_porosity = 0.5;
-// Verlet skin of the SPH pairs of the inertialess coupled scheme, / h: an SPH
-// particle moves ~1e-7 of h per sub-step, so the list lasts tens of sub-steps.
+// Verlet skin of the SPH pairs of the coupled schemes, / h: it changes no
+// result (the pairs come sorted, as a fresh search's would be); an SPH
+// particle's non-affine motion is a small fraction of h per step, so the
+// list lasts tens of steps.
 constexpr double k_sph_skin_over_h = 0.2;
 // Verlet skin of the DEM-SPH coupling pairs, / h. It changes no result (the
 // pairs equal a fresh search's); it trades the candidates' sweep,
@@ -132,12 +134,12 @@ CoupledTimeStep choose_coupled_time_step(const LoadedScene& scene, const DemPara
   }
   const StabilityLimit& bf = binding(t.fluid_limits);
   s.coupling_skin = k_coupling_skin_over_h * fluid.h;
+  s.sph_skin = k_sph_skin_over_h * fluid.h;
   if (inertialess) {
     const StabilityLimit& bd = binding(t.dem_limits);
     if (c.dt && *c.dt > bd.dt) refuse_dt_above(scene, *c.dt, bd, "implicit coupled step");
     s.dt_max = c.dt ? *c.dt : bd.dt;
     s.dt_fluid = c.dt_safety * bf.dt;
-    s.sph_skin = k_sph_skin_over_h * fluid.h;
     s.implicit.tol_over_radius = c.implicit_tol;
     s.implicit.newton_tol_over_radius = c.newton_tol;
     s.implicit.order = c.implicit_order;

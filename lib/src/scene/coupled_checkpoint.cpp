@@ -15,7 +15,8 @@
 // update_coupling_pairs(): the SPH pairs, summation densities, porosities,
 // fluid and wall pressures and wall densities, the DEM-SPH pairs (with the
 // wall mirror images), the SPH pair cache's candidates (found again from
-// its saved reference positions: the same sorted list) and the porosity
+// its saved reference positions: the same sorted list; the inertial scheme
+// saves none and builds its cache anew, the same pairs) and the porosity
 // range of sums_. The coupling pair cache is saved by its reference
 // positions, wall-mirrored particles, build time and count, and its
 // candidates found again from the reference positions (the same sorted
@@ -49,13 +50,11 @@ void CoupledModel::load(ArchiveReader& in) {
   fluid_.time = time_;
   fluid_.steps = steps_;
   // as at the end of step(); the SPH pair cache finds its candidates again
-  // at its reference positions
-  if (implicit_) {
-    restore_candidates(fluid_, sph_pairs_);
-    refresh(fluid_, sph_pairs_);
-  } else {
-    refresh(fluid_);
-  }
+  // at its reference positions (the inertial scheme does not save them: its
+  // cache is built anew, and the pairs are the same sorted list)
+  if (!implicit_) sph_pairs_.x_fluid.clear();
+  restore_candidates(fluid_, sph_pairs_);
+  refresh(fluid_, sph_pairs_);
   if (!coupling_cache_.dem_ref.empty())
     coupling_candidates(coupling_cache_.dem_ref, coupling_cache_.sph_ref, cell_.box,
                         k_kernel_support * fluid_.h + coupling_cache_.skin, coupling_cache_.candidates);

@@ -155,6 +155,8 @@ void CoupledModel::finish(RunSummary& s) const {
   } else {
     s.steps = steps_ * substeps_;  // DEM sub-steps
     s.extra["fluid_steps"] = static_cast<double>(steps_);
+    // (no sph_pair_builds: this scheme's checkpoint does not keep its SPH
+    // pair cache, so a resumed run would count one more build)
   }
 }
 
@@ -425,7 +427,8 @@ void CoupledModel::step() {
   fluid_.time = time_;
   ++steps_;
   fluid_.steps = steps_;
-  refresh(fluid_);
+  sph_pairs_.strain += p_.shear_rate * dt_;
+  refresh(fluid_, sph_pairs_);
   update_coupling_pairs();
   tally();
 }

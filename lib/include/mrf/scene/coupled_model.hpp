@@ -67,7 +67,7 @@ struct CoupledStepping {
   // inertialess: the SPH terms taken by backward Euler (viscosity: dt_fluid
   // then the CFL bound; pressure and viscosity: the advective bound)
   SphImplicit sph = SphImplicit::none;
-  double sph_skin = 0;    // inertialess: Verlet skin of the SPH pairs (m; 0 = search every sub-step)
+  double sph_skin = 0;    // Verlet skin of the SPH pairs (m; 0 = search every step)
   double coupling_skin = 0;  // Verlet skin of the DEM-SPH coupling pairs (m; 0 = search every step)
   ImplicitOptions implicit;  // inertialess
 };
