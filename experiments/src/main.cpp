@@ -251,7 +251,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   auto* ra = app.add_subcommand("reanalyse",
                                 "a finished run's statistics (wall stress, pair virial) re-estimated from its "
-                                "timeseries.csv by this version's block averaging, beside what its summary.json holds");
+                                "timeseries.csv (or a sweep archive entry's window_series.csv) by this version's block "
+                                "averaging, beside what its summary.json holds");
   std::vector<std::string> ra_dirs;
   ra->add_option("dirs", ra_dirs, "run directories (summary.json + timeseries.csv)")->required();
   CLI11_PARSE(app, argc, argv);

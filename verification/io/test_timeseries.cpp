@@ -44,6 +44,31 @@ TEST(TimeSeries, ReanalysingAFreshRunGivesItsSummary) {
     EXPECT_EQ(q["stored_mean"].get<double>(), c.m.mean) << c.key;
     EXPECT_GT(q["samples"].get<int>(), 32) << c.key;
   }
+
+  // The archive keeps only the window (and the row before it) of the
+  // columns a re-analysis reads: the same statistics from it.
+  const auto kept = std::filesystem::temp_directory_path() / "mrf_reanalyse_archived";
+  std::filesystem::remove_all(kept);
+  std::filesystem::create_directories(kept);
+  std::filesystem::copy_file(dir / "summary.json", kept / "summary.json");
+  const std::string text = window_series_text((dir / "timeseries.csv").string(), 0.2);
+  std::ofstream(kept / k_window_series_file) << text;
+  nlohmann::json a = nlohmann::json::parse(reanalyse_run(kept.string()));
+  nlohmann::json b = r;
+  a.erase("dir");
+  b.erase("dir");
+  EXPECT_EQ(a, b);
+  const TimeSeriesTable w = read_timeseries((kept / k_window_series_file).string());
+  const TimeSeriesTable full = read_timeseries((dir / "timeseries.csv").string());
+  EXPECT_EQ(w.column("strain").size(), r["stress_total"]["samples"].get<std::size_t>() + 1);
+  // its first row is the last warm-up row: it starts before 0.2 (where the
+  // row before it in the full file ends)
+  const std::size_t first = full.column("strain").size() - w.column("strain").size();
+  ASSERT_GT(first, 0u);
+  EXPECT_LT(full.column("strain")[first - 1], 0.2);
+  EXPECT_GE(w.column("strain").front(), 0.2);
+  EXPECT_LT(w.names.size(), full.names.size());  // energies and overlaps left out
+  EXPECT_EQ(w.column("stress_total_Pa").back(), full.column("stress_total_Pa").back());
 }
 
 TEST(TimeSeries, DamagedFileNamesItsLine) {

@@ -10,6 +10,7 @@
 #include "mrf/io/toml_scene.hpp"
 #include "mrf/scene/run.hpp"
 #include "mrf/scene/run_series.hpp"
+#include "mrf/io/timeseries.hpp"
 #include "mrf/study/sweep.hpp"
 
 namespace mrf {
@@ -76,8 +77,26 @@ TEST(SweepArchive, FinishedPointsSurviveTheLossOfTheOutputAndStaleEntriesRunAgai
   const SweepOutcome first = run_sweep(s, (root / "out1").string(), opt);
   ASSERT_EQ(first.ran, 2u);
   const auto pts = sweep_points(s);
-  for (const auto& p : pts)
+  for (const auto& p : pts) {
     EXPECT_EQ(slurp(archive / p.dir / "summary.json"), slurp(root / "out1" / p.dir / "summary.json")) << p.dir;
+    // and the averaging window's series, for a later re-analysis
+    EXPECT_NE(slurp(archive / p.dir / k_window_series_file).find("stress_total_Pa"), std::string::npos) << p.dir;
+  }
+
+  // An entry archived before the window series existed gets it back from
+  // the run in the output whose summary it holds (and only from that run).
+  std::filesystem::remove(archive / pts[0].dir / k_window_series_file);
+  const ArchiveSync backfill = restore_from_archive(s, pts, (root / "out1").string(), archive.string());
+  EXPECT_EQ(backfill.series_added, 1u);
+  EXPECT_EQ(backfill.restored, 0u);
+  EXPECT_TRUE(std::filesystem::exists(archive / pts[0].dir / k_window_series_file));
+  const auto other = root / "other";  // a finished run whose summary is not the entry's
+  std::filesystem::copy(root / "out1", other, std::filesystem::copy_options::recursive);
+  std::ofstream(other / pts[1].dir / "summary.json", std::ios::app) << " ";
+  std::filesystem::remove(archive / pts[1].dir / k_window_series_file);
+  EXPECT_EQ(restore_from_archive(s, pts, other.string(), archive.string()).series_added, 0u);
+  EXPECT_FALSE(std::filesystem::exists(archive / pts[1].dir / k_window_series_file));
+  EXPECT_EQ(restore_from_archive(s, pts, (root / "out1").string(), archive.string()).series_added, 1u);
 
   // A new machine: the output is gone, the archive is not. Nothing runs, the
   // summaries come back byte for byte, sweep.csv is complete.

@@ -60,6 +60,43 @@ std::vector<double> averaging_window(const TimeSeriesTable& t, const std::string
   return out;
 }
 
+namespace {
+// what reanalyse_run reads: the window's strain and the measurements
+const std::vector<std::string> k_series_columns = {"time_s", "strain", "stress_total_Pa", "stress_particles_Pa",
+                                                   "stress_fluid_Pa", "stress_virial_magnetic_Pa",
+                                                   "stress_virial_contact_Pa"};
+}  // namespace
+
+std::string window_series_text(const std::string& timeseries_path, double warmup_strain) {
+  const TimeSeriesTable t = read_timeseries(timeseries_path);  // validates every row
+  std::vector<std::size_t> keep;
+  for (const auto& name : k_series_columns)
+    for (std::size_t k = 0; k < t.names.size(); ++k)
+      if (t.names[k] == name) keep.push_back(k);
+  const std::vector<double>& strain = t.column("strain");  // throws, naming the file, when absent
+  // the first row of the window (as averaging_window takes it), less one
+  std::size_t first = strain.size();
+  for (std::size_t r = 0; r < strain.size(); ++r)
+    if ((r == 0 ? 0.0 : strain[r - 1]) >= warmup_strain * (1 - 1e-12)) {
+      first = r;
+      break;
+    }
+  const std::size_t from = first == 0 ? 0 : first - 1;
+  std::ifstream in(timeseries_path);
+  std::string line, out;
+  auto put = [&](const std::vector<std::string>& f) {
+    for (std::size_t k = 0; k < keep.size(); ++k) out += (k ? "," : "") + f[keep[k]];
+    out += '\n';
+  };
+  std::getline(in, line);
+  put(split_csv_line(line));
+  for (std::size_t r = 0; std::getline(in, line);) {
+    if (line.empty()) continue;
+    if (r++ >= from) put(split_csv_line(line));
+  }
+  return out;
+}
+
 std::string reanalyse_run(const std::string& dir) {
   const std::filesystem::path d(dir);
   std::ifstream in(d / "summary.json");
@@ -67,7 +104,8 @@ std::string reanalyse_run(const std::string& dir) {
   const nlohmann::json s = nlohmann::json::parse(in, nullptr, false);
   if (s.is_discarded() || !s.contains("warmup_strain") || !s["warmup_strain"].is_number())
     throw InputError("summary.json", (d / "summary.json").string(), "", "unreadable or without warmup_strain");
-  const TimeSeriesTable t = read_timeseries((d / "timeseries.csv").string());
+  const bool archived = !std::filesystem::exists(d / "timeseries.csv") && std::filesystem::exists(d / k_window_series_file);
+  const TimeSeriesTable t = read_timeseries((d / (archived ? k_window_series_file : "timeseries.csv")).string());
   const double warmup = s["warmup_strain"].get<double>();
   nlohmann::ordered_json out;
   out["dir"] = dir;

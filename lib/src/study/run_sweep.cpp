@@ -71,6 +71,9 @@ void report_archive(const ArchiveSync& sync, const std::string& archive_dir, boo
   if (sync.restored > 0)
     std::fprintf(stderr, "mrf sweep: %zu finished points restored from the archive %s\n", sync.restored,
                  archive_dir.c_str());
+  if (sync.series_added > 0)
+    std::fprintf(stderr, "mrf sweep: %zu archive entries got their window series from the runs in the output\n",
+                 sync.series_added);
   for (const std::string& d : sync.stale)
     std::fprintf(stderr, "mrf sweep: archive entry %s/%s is for another scene (scene_id differs): ignored, the point runs\n",
                  archive_dir.c_str(), d.c_str());

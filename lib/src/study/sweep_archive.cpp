@@ -9,6 +9,7 @@
 #include "mrf/error.hpp"
 #include "mrf/io/archive.hpp"
 #include "mrf/io/atomic_file.hpp"
+#include "mrf/io/timeseries.hpp"
 #include "mrf/scene/run_series.hpp"
 #include "mrf/io/toml_scene.hpp"
 #include "mrf/study/sweep.hpp"
@@ -31,7 +32,18 @@ ArchiveSync restore_from_archive(const SweepSpec& spec, const std::vector<SweepP
   for (const SweepPoint& p : points) {
     const auto entry = std::filesystem::path(archive_dir) / p.dir / "summary.json";
     const auto dir = std::filesystem::path(out_dir) / p.dir;
-    if (!std::filesystem::exists(entry) || point_finished(dir.string())) continue;
+    if (!std::filesystem::exists(entry)) continue;
+    if (point_finished(dir.string())) {
+      // an entry archived without its window series (before session 25)
+      // gets it from the run that wrote it, while that run's folder is here
+      if (!std::filesystem::exists(entry.parent_path() / k_window_series_file) &&
+          std::filesystem::exists(dir / "summary.json") && read_text(dir / "summary.json") == read_text(entry) &&
+          std::filesystem::exists(dir / "timeseries.csv")) {
+        archive_point(p, out_dir, archive_dir);
+        ++sync.series_added;
+      }
+      continue;
+    }
     const std::string text = read_text(entry);
     const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
     const std::string want = scene_id(load_scene(spec.scene_path, p.sets).config);
@@ -119,6 +131,14 @@ void archive_point(const SweepPoint& p, const std::string& out_dir, const std::s
   const auto dir = std::filesystem::path(archive_dir) / p.dir;
   std::filesystem::create_directories(dir);
   write_file_atomic((dir / "summary.json").string(), read_text(summary));
+  // the averaging window's series, for re-estimating the point later
+  // (io/timeseries.hpp); a run without one (output.every = 0) keeps none
+  const auto series = std::filesystem::path(out_dir) / p.dir / "timeseries.csv";
+  const nlohmann::json s = nlohmann::json::parse(read_text(summary), nullptr, false);
+  if (std::filesystem::exists(series) && !s.is_discarded() && s.contains("warmup_strain") &&
+      s["warmup_strain"].is_number())
+    write_file_atomic((dir / k_window_series_file).string(),
+                      window_series_text(series.string(), s["warmup_strain"].get<double>()));
 }
 
 }  // namespace mrf

@@ -28,8 +28,20 @@ TimeSeriesTable read_timeseries(const std::string& path);
 // did not take it.
 std::vector<double> averaging_window(const TimeSeriesTable& t, const std::string& column, double warmup_strain);
 
+// The columns a re-analysis reads (reanalyse_run), and the rows it can
+// read them from: the time series' averaging window for `warmup_strain`,
+// preceded by the last warm-up row (whose end is where the window starts),
+// those columns only, each field as the file wrote it. The sweep archive
+// keeps this beside a point's summary.json (window_series.csv, a few
+// hundred kB at most), so that a later estimator can be applied to runs
+// whose output folder is gone. Throws InputError (file, line) as
+// read_timeseries does.
+inline const char* const k_window_series_file = "window_series.csv";
+std::string window_series_text(const std::string& timeseries_path, double warmup_strain);
+
 // The statistics of the named measurements of a finished run (directory
-// with summary.json and timeseries.csv) by the current estimator, as JSON:
+// with summary.json and timeseries.csv, or an archive entry with
+// summary.json and window_series.csv) by the current estimator, as JSON:
 // per measurement mean, err, drift_z, independent_samples, and beside
 // them what summary.json holds (`stored_*`, and the summary's
 // error_estimate_version, 1 when absent). Measurements: stress_total,

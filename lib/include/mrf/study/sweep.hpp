@@ -176,11 +176,16 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
 struct ArchiveSync {
   std::size_t restored = 0;  // entries copied into the output (points now finished there)
   std::vector<std::string> stale;  // point folders whose entry is for another scene
+  // entries without a window_series.csv that got one from the finished run
+  // in the output whose summary.json they hold
+  std::size_t series_added = 0;
 };
 ArchiveSync restore_from_archive(const SweepSpec& spec, const std::vector<SweepPoint>& points,
                                  const std::string& out_dir, const std::string& archive_dir);
-// Copies a finished point's summary.json into the archive (atomically); a
-// point without one (failed, unfinished) leaves the archive as it is.
+// Copies a finished point's summary.json into the archive (atomically),
+// with its averaging window's series (window_series.csv, io/timeseries.hpp)
+// when the run wrote a time series; a point without a summary (failed,
+// unfinished) leaves the archive as it is.
 void archive_point(const SweepPoint& p, const std::string& out_dir, const std::string& archive_dir);
 // What a restore did, on stderr (nothing when quiet).
 void report_archive(const ArchiveSync& sync, const std::string& archive_dir, bool quiet);
