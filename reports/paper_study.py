@@ -13,6 +13,7 @@ usage: paper_study.py SWEEP_DIR OUT_DIR [--small reports/study/flow_curves.csv]
                       [--aqs-seeds headline_0.45,seed2,seed3]
                       [--first-runs reports/study/paper/first_runs] [--note TEXT]
                       [--small-criterion reports/study/criterion_default.json]
+                      [--reanalysed reports/study/paper/reanalysed.json]
 
 The fixed-M path (experiments/sweeps/paper_fixed_m.toml, collected with
 `mrf sweep ... --archive reports/study/paper/fixed_m_points --collect`, then
@@ -30,6 +31,9 @@ window) with the standard error of their scatter.
 --first-runs: the summaries of the first runs of points re-run for
 steadiness, listed under the steadiness table with what their re-runs gave.
 --note: a paragraph under the title (what state the report is in).
+--reanalysed: `mrf reanalyse` records of archived runs (scripts/paper_interim.py
+writes them from the archive's window_series.csv files), for a post-hoc
+reading of the particle-part rule on runs that carry the plain estimate.
 --small-criterion: mrf criterion's output for the small-cell study, whose
 claims are re-measured on the paper cell (deviations from model 3, model 1's
 volume-side stress, the slope of the flow curve at the lowest Mn).
@@ -93,6 +97,28 @@ def particle_rule(r):
 def mkey(mn):
     """A Mason number as a dictionary key that sweep.csv and criterion.json agree on."""
     return float(f"{float(mn):.6g}")
+
+
+def post_hoc(argv, here, rows):
+    """The particle-part rule read post hoc on the archived runs that carry the
+    plain estimate but kept their window series (scripts/paper_interim.py:
+    reanalysed.json, `mrf reanalyse` of each): (model, Mn, seed) -> verdict.
+    These runs were seen before the rule was written, so this is not a test
+    of it."""
+    path = arg(argv, "--reanalysed", os.path.join(here, "study", "paper", "reanalysed.json"))
+    if not os.path.exists(path):
+        return {}
+    strain = {(r["model"], mkey(r["mason"]), int(r["seed"])): num(r, "strain") for r in rows}
+    out = {}
+    for q in json.load(open(path)):
+        key = (q["model"], mkey(q["mason"]), int(q["seed"]))
+        if q.get("stored_error_estimate_version", 1) >= 2 or strain.get(key) != q["strain"]:
+            continue  # judged by the rule itself, or another run than the table's
+        out[key] = particle_rule({"error_estimate_version": 2,
+                                  "stress_particles_drift_z": q["stress_particles"]["drift_z"],
+                                  "stress_particles_independent_samples": q["stress_particles"]["independent_samples"],
+                                  "stress_total_independent_samples": q["stress_total"]["independent_samples"]})
+    return out
 
 
 def particle_state(rows):
@@ -402,6 +428,7 @@ def main(argv):
               "| model | Mn | seed | strain (warm-up) | drift z | MSER discard | steady | independent samples "
               "(version 2) | particle part: drift z, independent samples | particle-part rule | s per strain unit |",
               "|---|---:|---:|---:|---:|---:|---|---:|---:|---|---:|"]
+    late = post_hoc(argv, here, rows)
     for r in sorted(rows, key=lambda r: (ORDER.index(r["model"]), float(r["mason"]), int(r["seed"]))):
         per = num(r, "wall_seconds") / num(r, "strain")
         ind = num(r, "stress_total_independent_samples")
@@ -410,10 +437,21 @@ def main(argv):
         pcol = pzs + ("" if math.isnan(pind) else f", {pind:.0f}")
         pr = particle_rule(r)
         pr = pr if pr in ("ok", "untested") else f"**{pr}**"
+        ph = late.get((r["model"], mkey(r["mason"]), int(r["seed"])))
+        if pr == "untested" and ph:
+            pr += f"; post hoc: {ph}"
         lines.append(f"| {r['model']} | {float(r['mason']):g} | {r['seed']} | {num(r, 'strain'):g} "
                      f"({num(r, 'warmup_strain'):g}) | {num(r, 'stress_total_drift_z'):+.2f} | "
                      f"{num(r, 'steady_mser_discard_fraction'):.3f} | {'yes' if steady(r) else '**no**'} | "
                      f"{'–' if math.isnan(ind) else f'{ind:.0f}'} | {pcol} | {pr} | {per:.3g} |")
+    if late:
+        bad = sorted(k for k, v in late.items() if v != "ok")
+        lines += ["", f"Post hoc: {len(late)} runs that carry the plain estimate kept their averaging window "
+                  "(window_series.csv in the archive) and were re-analysed with the version-2 estimate "
+                  "(`mrf reanalyse`; reanalysed.json). Read by the particle-part rule, "
+                  f"{len(bad)} of them fail: " + (", ".join(f"{m} Mn {mn:g} seed {sd}" for m, mn, sd in bad) or "none")
+                  + ". These runs were seen before the rule was written: this is a reading, not a test of the rule, "
+                  "and the tables above keep them 'untested'."]
     # The first runs of points re-run for steadiness (their summaries kept
     # in first_runs/ before the re-run overwrote the archive entry).
     first_dir = arg(argv, "--first-runs", os.path.join(here, "study", "paper", "first_runs"))
