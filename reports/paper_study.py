@@ -14,6 +14,7 @@ usage: paper_study.py SWEEP_DIR OUT_DIR [--small reports/study/flow_curves.csv]
                       [--first-runs reports/study/paper/first_runs] [--note TEXT]
                       [--small-criterion reports/study/criterion_default.json]
                       [--reanalysed reports/study/paper/reanalysed.json]
+                      [--convergence reports/study/paper/convergence.md]
 
 The fixed-M path (experiments/sweeps/paper_fixed_m.toml, collected with
 `mrf sweep ... --archive reports/study/paper/fixed_m_points --collect`, then
@@ -34,6 +35,8 @@ steadiness, listed under the steadiness table with what their re-runs gave.
 --reanalysed: `mrf reanalyse` records of archived runs (scripts/paper_interim.py
 writes them from the archive's window_series.csv files), for a post-hoc
 reading of the particle-part rule on runs that carry the plain estimate.
+--convergence: the convergence table (reports/paper_convergence.py), whose
+largest-lever lines the opening section repeats.
 --small-criterion: mrf criterion's output for the small-cell study, whose
 claims are re-measured on the paper cell (deviations from model 3, model 1's
 volume-side stress, the slope of the flow curve at the lowest Mn).
@@ -277,6 +280,65 @@ def old_claims(crit, small_crit, phi, small_m, pstate=None):
             if s:
                 lines.append(f"| {k} | {name} | " + " | ".join(s) + " |")
     lines.append("")
+    return lines
+
+
+def answers(crit, small, phi, small_m, pstate, unsteady, claim_lines, cost_line, conv_path):
+    """The section a reader wants first: the three models' stress at Mn 1e-2
+    and 1 on the paper cell and the small cell, how settled each number is,
+    the largest numerical lever (the convergence table), what the whole sweep
+    cost and which of the small-cell study's claims survive. Every number is
+    the one a later section derives; this only gathers them."""
+    lines = ["## The answers so far", "",
+             "Gathered from the sections below (nothing here is computed only here). Stress / (phi mu0 M^2), "
+             "seed-combined, error = max(within-run, seed scatter / sqrt(n)); 'runs not steady': runs of the "
+             "point that fail the drift or MSER-5 test (after their re-run, or the first run while the re-run is "
+             "pending: the steadiness section lists them); 'particle part': how many runs pass "
+             "the session-25 particle-part rule, fail it, or predate it (untested).", "",
+             "| model | Mn | paper cell | small cell | paper - small (sigma) | runs not steady | particle part |",
+             "|---|---:|---:|---:|---:|---:|---|"]
+    for m in (1e-2, 1.0):
+        for k in [x for x in ORDER if x in crit["models"]]:
+            q = next((q for q in crit["models"][k]["points"] if mkey(q["mason"]) == mkey(m)), None)
+            if q is None:
+                continue
+            sc = phi * MU0 * q["magnetization"] ** 2
+            t, e = q["stress"] / sc, q["err"] / sc
+            sm = small[k].get(q["mason"])
+            if sm:
+                ss = phi * MU0 * small_m ** 2
+                st, se = sm[0] / ss, sm[1] / ss
+                cmp_ = f"{st:.4f} ± {se:.4f} | {(t - st) / math.hypot(e, se):+.1f}"
+            else:
+                cmp_ = "– | –"
+            c = pstate.get((k, mkey(m)), [0, 0, 0])
+            part = f"{c[2] - c[0] - c[1]} pass, {c[0]} fail, {c[1]} untested"
+            lines.append(f"| {k} | {m:g} | {t:.4f} ± {e:.4f} | {cmp_} | {unsteady.get((k, mkey(m)), 0)} of "
+                         f"{q['seeds']} | {part} |")
+    lines.append("")
+    if os.path.exists(conv_path):
+        conv = open(conv_path).read()
+        lever = [x[2:] for x in conv.split("The largest lever per model and Mn")[-1].split("\n\n")[1].splitlines()
+                 if x.startswith("- ")] if "The largest lever per model and Mn" in conv else []
+        if lever:
+            lines += ["The largest numerical lever (reports/study/paper/convergence.md, one seed per variant, "
+                      "still filling in): " + "; ".join(lever) + ".", ""]
+    verdicts = defaultdict(lambda: [0, 0])
+    for x in claim_lines:
+        cells = [c.strip() for c in x.strip("|").split("|")]
+        if len(cells) == 5 and cells[4] in ("yes", "**no**"):
+            verdicts[cells[0]][cells[4] != "yes"] += 1
+    if verdicts:
+        lines += ["The small-cell study's claims on the paper cell (holds at how many of the Mn tested; the claims "
+                  "section below has each value):", ""]
+        lines += [f"- {claim}: holds at {v[0]} of {v[0] + v[1]}" for claim, v in verdicts.items()]
+        flat = [[c.strip() for c in x.strip("|").split("|")] for x in claim_lines if "| paper | " in x]
+        if flat:
+            lines.append("- no yield plateau down to Mn = 1e-3: the paper cell's particle part between the two "
+                         "lowest Mn is " + "; ".join(f"{c[0]} s = {c[4]}, {'flat' if c[6] == 'yes' else 'not flat'}"
+                                                     for c in flat))
+        lines.append("")
+    lines += [cost_line, ""]
     return lines
 
 
@@ -600,8 +662,17 @@ def main(argv):
     lines.append("")
     small_crit_path = arg(argv, "--small-criterion", os.path.join(here, "study", "criterion_default.json"))
     small_crit = json.load(open(small_crit_path)) if os.path.exists(small_crit_path) else None
-    lines += old_claims(crit, small_crit, phi, small_m, particle_state(rows))
+    claims = old_claims(crit, small_crit, phi, small_m, particle_state(rows))
+    lines += claims
     lines += two_paths(argv, here, crit, phi, models)
+    unsteady = defaultdict(int)
+    for r in rows:
+        unsteady[(r["model"], mkey(r["mason"]))] += 0 if steady(r) else 1
+    cost = next((x for x in lines if x.startswith("Whole-sweep wall time")), "")
+    head = answers(crit, small, phi, small_m, particle_state(rows), unsteady, claims, cost,
+                   arg(argv, "--convergence", os.path.join(here, "study", "paper", "convergence.md")))
+    at = lines.index("![stress](stress_vs_mason.png)") + 2
+    lines[at:at] = head
     with open(os.path.join(out, "paper.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     print(f"-> {os.path.join(out, 'paper.md')}")

@@ -158,6 +158,20 @@ def main(argv):
     slope = [x for x in md.splitlines() if x.startswith("| demsph_dd | paper | ")]
     if not slope or not [x.strip() for x in slope[0].strip("|").split("|")][4].endswith("(3 fail)"):
         failures.append(f"the demsph_dd particle slope should carry '(3 fail)': {slope}")
+    # The opening section repeats the stress table at Mn 1e-2 and 1, and the
+    # particle-part counts.
+    head = md.split("## The answers so far")[1].split("\n## ")[0] if "## The answers so far" in md else ""
+    for k in MODELS:
+        for mn in (1e-2, 1.0):
+            hit = [x for x in head.splitlines() if x.startswith(f"| {k} | {mn:g} | ")]
+            if not hit:
+                failures.append(f"no answers row for {k} Mn {mn:g}")
+                continue
+            cells = [x.strip() for x in hit[0].strip("|").split("|")]
+            check(f"answers: {k} Mn {mn:g}", float(value.match(cells[2]).group(1)), total(k, mn), 1e-4 * total(k, mn) + 1e-4)
+            want = "3 pass, 0 fail, 0 untested" if (k, mn) == ("demsph_dd", 1e-2) else "0 pass, 0 fail, 3 untested"
+            if cells[6] != want:
+                failures.append(f"answers: {k} Mn {mn:g} particle part '{cells[6]}', want '{want}'")
     for f in failures:
         print("FAIL:", f)
     print(f"paper report check: {len(failures)} failure(s)")
