@@ -58,8 +58,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from study import (CHAIN_YIELD, COLOR, LABEL, MN_CONVENTION, MU0, ORDER, experiment_points,  # noqa: E402
-                   num, read_rows, save)
+from study import (CHAIN_YIELD, COLOR, GINDER_SAT, LABEL, MN_CONVENTION, MU0, ORDER,  # noqa: E402
+                   experiment_points, num, read_rows, save)
 
 DRIFT_Z, MSER_MAX = 3.0, 0.2  # steadiness tests of every point (DESIGN.md, issue 13)
 # The particle-part rule, fixed in session 25 before any window it judges had
@@ -414,6 +414,7 @@ def main(argv):
                 ax.plot([8e-4] * len(others), others, "k.", ms=4, alpha=0.5, label="AQS variants (increment, tol, "
                         "cut-off, seed, Y)")
         ax.axhline(CHAIN_YIELD, color="k", ls="--", lw=1, label="chain model yield 0.137")
+        ax.axhline(GINDER_SAT, color="gray", ls=":", lw=1, label="Ginder saturation 0.086 (Ms = M)")
         sources = sorted({e[0] for e in expt})
         for src in sources:
             vals = [v for s_, _, v in expt if s_ == src]
