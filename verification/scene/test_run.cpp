@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "mrf/error.hpp"
+#include "mrf/io/timeseries.hpp"
 #include "mrf/io/toml_scene.hpp"
 #include "mrf/scene/build_model.hpp"
 #include "mrf/scene/dem_model.hpp"
@@ -50,14 +51,16 @@ struct RunResult {
   LoadedScene scene;
   RunSummary summary;
   std::string json, timeseries;  // file contents
+  TimeSeriesTable table;         // timeseries.csv as the library reads it back
 };
 
 RunResult run(const std::vector<std::string>& overrides = {}) {
-  RunResult r{scene(overrides), {}, {}, {}};
+  RunResult r{scene(overrides), {}, {}, {}, {}};
   const TempDir dir("run");
   r.summary = run_scene(r.scene, RunOptions{dir.path().string(), true});
   r.json = read_bytes(dir.path() / "summary.json");
   r.timeseries = read_bytes(dir.path() / "timeseries.csv");
+  if (fs::exists(dir.path() / "timeseries.csv")) r.table = read_timeseries((dir.path() / "timeseries.csv").string());
   return r;
 }
 
@@ -67,149 +70,38 @@ const RunResult& base_run() {
   return r;
 }
 
-std::vector<std::string> split(const std::string& line, char sep) {
-  std::vector<std::string> out;
-  std::string cell;
-  std::istringstream in(line);
-  while (std::getline(in, cell, sep)) out.push_back(cell);
-  return out;
-}
-
-struct Csv {
-  std::vector<std::string> header;
-  std::vector<std::vector<double>> rows;
-  std::size_t column(const std::string& name) const {
-    for (std::size_t i = 0; i < header.size(); ++i)
-      if (header[i] == name) return i;
-    ADD_FAILURE() << "no column " << name;
-    return 0;
-  }
-};
-
-Csv parse_csv(const std::string& text) {
-  Csv csv;
-  std::istringstream in(text);
-  std::string line;
-  if (std::getline(in, line)) csv.header = split(line, ',');
-  while (std::getline(in, line)) {
-    std::vector<double> row;
-    for (const std::string& cell : split(line, ',')) row.push_back(std::strtod(cell.c_str(), nullptr));
-    csv.rows.push_back(std::move(row));
-  }
-  return csv;
-}
-
-// ---- summary.json and timeseries.csv --------------------------------------
-
-const char* const k_design_keys[] = {
-    "model", "mason", "shear_rate", "strain", "warmup_strain", "stress_total",
-    "stress_total_err", "stress_particles", "stress_fluid", "stress_virial", "n_particles",
-    "n_fluid", "dt", "steps", "wall_seconds", "stokes_number", "reynolds_number",
-    "max_overlap_over_radius", "version"};
-
-TEST(RunOutput, SummaryJsonHasEveryKeyOfTheDesign) {
-  const RunResult& r = base_run();
-  const nlohmann::json j = nlohmann::json::parse(r.json);
-  for (const char* key : k_design_keys) {
-    ASSERT_TRUE(j.contains(key)) << key;
-    if (std::string(key) == "model" || std::string(key) == "version") {
-      EXPECT_TRUE(j[key].is_string()) << key;
-    } else {
-      ASSERT_TRUE(j[key].is_number()) << key << " = " << j[key].dump();
-      EXPECT_TRUE(std::isfinite(j[key].get<double>())) << key << " = " << j[key].dump();
-    }
-  }
-  const RunSummary& s = r.summary;
-  EXPECT_EQ(j["model"], "dem_stokes");
-  EXPECT_EQ(j["version"], MRF_VERSION);
-  // the git revision the binary was built from (cmake/revision.cmake)
-  ASSERT_TRUE(j.contains("git_revision"));
-  EXPECT_EQ(j["git_revision"], git_revision());
-  EXPECT_FALSE(j["git_revision"].get<std::string>().empty());
-  EXPECT_EQ(j["strain"].get<double>(), k_strain);
-  EXPECT_EQ(j["warmup_strain"].get<double>(), k_warmup);
-  EXPECT_EQ(j["n_particles"].get<long>(), static_cast<long>(particle_count(r.scene.config)));
-  EXPECT_EQ(j["n_fluid"].get<long>(), 0);  // dem_stokes allocates no fluid
-  EXPECT_EQ(j["steps"].get<long>(), s.steps);
-  EXPECT_EQ(j["steps"].get<long>(),
-            static_cast<long>(std::ceil(k_strain / (s.shear_rate * s.dt))));
-  // The file holds the returned numbers exactly.
-  EXPECT_TRUE(same_bits(j["stress_total"].get<double>(), s.stress_total.mean));
-  EXPECT_TRUE(same_bits(j["stress_total_err"].get<double>(), s.stress_total.err));
-  EXPECT_TRUE(same_bits(j["stress_virial"].get<double>(), s.stress_virial.mean));
-  EXPECT_TRUE(same_bits(j["dt"].get<double>(), s.dt));
-  EXPECT_GT(j["stress_total_err"].get<double>(), 0);
-  EXPECT_GT(j["wall_seconds"].get<double>(), 0);
-  EXPECT_GT(j["max_overlap_over_radius"].get<double>(), 0);
-  EXPECT_LT(j["max_overlap_over_radius"].get<double>(), 0.05);
-  EXPECT_NEAR(j["stokes_number"].get<double>(), dem_params(r.scene.config).tau_p * s.shear_rate,
-              1e-15);
-  EXPECT_DOUBLE_EQ(j["reynolds_number"].get<double>(), 1000 * s.shear_rate * 2.5e-6 * 2.5e-6 / k_eta);
-}
-
-// Non-magnetic particles (M = 0) with a given shear rate run, and the
-// infinite Mason number is stated, not left as a bare null (or an "inf" that
-// is no JSON): summary.json holds "mason": null beside its reason.
-TEST(RunOutput, ZeroMagnetizationRunsAndStatesTheInfiniteMasonNumber) {
-  const LoadedScene s = scene({"particles.magnetization=0", "drive.shear_rate=1e3"});
-  ASSERT_TRUE(std::isinf(s.config.mason));
-  const RunSummary r = run_scene(s, RunOptions{"", true});
-  EXPECT_TRUE(std::isinf(r.mason));
-  EXPECT_TRUE(std::isfinite(r.stress_total.mean));
-  const std::string text = summary_json(r);
-  const nlohmann::json j = nlohmann::json::parse(text);  // strict JSON
-  ASSERT_TRUE(j.contains("mason"));
-  EXPECT_TRUE(j["mason"].is_null()) << j["mason"].dump();
-  ASSERT_TRUE(j.contains("mason_note") && j["mason_note"].is_string()) << text;
-  EXPECT_NE(j["mason_note"].get<std::string>().find("particles.magnetization = 0"), std::string::npos);
-  EXPECT_EQ(j["shear_rate"].get<double>(), 1e3);
-  EXPECT_EQ(j["magnetization"].get<double>(), 0.0);
-}
-
-// The carrier fluid's viscosity and density are in summary.json (mrf
-// criterion reads the viscosity from there, through sweep.csv).
-TEST(RunOutput, SummaryJsonHasTheFluidViscosityAndDensity) {
-  const RunResult& r = base_run();
-  const nlohmann::json j = nlohmann::json::parse(r.json);
-  ASSERT_TRUE(j.contains("viscosity") && j["viscosity"].is_number()) << r.json;
-  ASSERT_TRUE(j.contains("fluid_density") && j["fluid_density"].is_number()) << r.json;
-  EXPECT_EQ(j["viscosity"].get<double>(), r.scene.config.viscosity);
-  EXPECT_EQ(j["viscosity"].get<double>(), k_eta);
-  EXPECT_EQ(j["fluid_density"].get<double>(), 1000.0);
-}
-
 TEST(RunOutput, TimeseriesHasOneRowPerOutputInterval) {
   const RunResult& r = base_run();
   const RunSummary& s = r.summary;
-  const Csv csv = parse_csv(r.timeseries);
-  ASSERT_GE(csv.header.size(), 8u);
-  EXPECT_EQ(csv.header[0], "time_s");
-  EXPECT_EQ(csv.header[1], "strain");
-  const std::size_t strain = csv.column("strain"), time = csv.column("time_s"),
-                    total = csv.column("stress_total_Pa"),
-                    particles = csv.column("stress_particles_Pa"),
-                    fluid = csv.column("stress_fluid_Pa");
-  ASSERT_EQ(csv.rows.size(), static_cast<std::size_t>((s.steps + k_every - 1) / k_every));
+  // read_timeseries refuses a row of another length or a field that is not a number
+  const TimeSeriesTable& csv = r.table;
+  ASSERT_GE(csv.names.size(), 8u);
+  EXPECT_EQ(csv.names[0], "time_s");
+  EXPECT_EQ(csv.names[1], "strain");
+  const auto& strain = csv.column("strain");
+  const auto& time = csv.column("time_s");
+  const auto& total = csv.column("stress_total_Pa");
+  const auto& particles = csv.column("stress_particles_Pa");
+  const auto& fluid = csv.column("stress_fluid_Pa");
+  ASSERT_EQ(strain.size(), static_cast<std::size_t>((s.steps + k_every - 1) / k_every));
   const double step_strain = s.shear_rate * s.dt;
   double sum = 0;
   int n = 0;
-  for (std::size_t i = 0; i < csv.rows.size(); ++i) {
-    const std::vector<double>& row = csv.rows[i];
-    ASSERT_EQ(row.size(), csv.header.size()) << "row " << i;
-    for (double x : row) EXPECT_TRUE(std::isfinite(x)) << "row " << i;
+  for (std::size_t i = 0; i < strain.size(); ++i) {
+    for (const auto& c : csv.columns) EXPECT_TRUE(std::isfinite(c[i])) << "row " << i;
     if (i > 0) {
-      EXPECT_GT(row[strain], csv.rows[i - 1][strain]) << "row " << i;
+      EXPECT_GT(strain[i], strain[i - 1]) << "row " << i;
     }
     const long n_step = std::min<long>(static_cast<long>(i + 1) * k_every, s.steps);
-    EXPECT_NEAR(row[strain], static_cast<double>(n_step) * step_strain, 1e-5 * row[strain]) << i;
-    EXPECT_NEAR(row[time] * s.shear_rate, row[strain], 1e-5 * row[strain]) << "row " << i;
-    EXPECT_NEAR(row[total], row[particles] + row[fluid], 1e-5 * std::abs(row[total])) << i;
-    if (row[strain] - static_cast<double>(k_every) * step_strain >= k_warmup - 1e-12) {  // whole row after warm-up
-      sum += row[total];
+    EXPECT_NEAR(strain[i], static_cast<double>(n_step) * step_strain, 1e-5 * strain[i]) << i;
+    EXPECT_NEAR(time[i] * s.shear_rate, strain[i], 1e-5 * strain[i]) << "row " << i;
+    EXPECT_NEAR(total[i], particles[i] + fluid[i], 1e-5 * std::abs(total[i])) << i;
+    if (strain[i] - static_cast<double>(k_every) * step_strain >= k_warmup - 1e-12) {  // whole row after warm-up
+      sum += total[i];
       ++n;
     }
   }
-  const double last = csv.rows.back()[strain];
+  const double last = strain.back();
   EXPECT_GE(last, k_strain * (1 - 1e-6));
   EXPECT_LE(last, k_strain + step_strain * (1 + 1e-4));
   // The summary averages the rows after the warm-up (6 digits in the file).
