@@ -294,7 +294,10 @@ def answers(crit, small, phi, small_m, pstate, unsteady, claim_lines, cost_line,
              "seed-combined, error = max(within-run, seed scatter / sqrt(n)); 'runs not steady': runs of the "
              "point that fail the drift or MSER-5 test (after their re-run, or the first run while the re-run is "
              "pending: the steadiness section lists them); 'particle part': how many runs pass "
-             "the session-25 particle-part rule, fail it, or predate it (untested).", "",
+             "the session-25 particle-part rule, fail it, or predate it (untested). Where the seed scatter sets "
+             "the error (most coupled points: the stress table's ratio column), it rests on 3 seeds, 2 degrees of "
+             "freedom: a 95 % interval is then 4.3 standard errors wide each side (Student's t), so a difference of "
+             "2-4 sigma is suggestive, not established.", "",
              "| model | Mn | paper cell | small cell | paper - small (sigma) | runs not steady | particle part |",
              "|---|---:|---:|---:|---:|---:|---|"]
     for m in (1e-2, 1.0):
