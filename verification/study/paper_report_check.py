@@ -172,6 +172,14 @@ def main(argv):
             want = "3 pass, 0 fail, 0 untested" if (k, mn) == ("demsph_dd", 1e-2) else "0 pass, 0 fail, 3 untested"
             if cells[6] != want:
                 failures.append(f"answers: {k} Mn {mn:g} particle part '{cells[6]}', want '{want}'")
+    # Against theory and experiment: each model's particle part at the lowest
+    # Mn is c_k (the synthetic fluids' particle stress is flat).
+    sect = md.split("## Against theory and experiment")[1].split("\n## ")[0] if "## Against theory" in md else ""
+    lows = [x for x in sect.splitlines() if "particle part at Mn 0.001" in x]
+    if len(lows) != len(MODELS):
+        failures.append(f"{len(lows)} lowest-Mn rows in the theory section, want {len(MODELS)}")
+    for line, (k, (c, _)) in zip(lows, MODELS.items()):
+        check(f"theory section, {k} particle part", float(value.match(line.split("|")[2].strip()).group(1)), c, 1e-4)
     for f in failures:
         print("FAIL:", f)
     print(f"paper report check: {len(failures)} failure(s)")
