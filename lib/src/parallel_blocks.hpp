@@ -68,4 +68,25 @@ std::vector<std::size_t> in_blocks(std::size_t n, std::size_t per_thread, std::v
   return begin;
 }
 
+// The same with two lists filled side by side (entry k of one belongs to
+// entry k of the other): body(lo, hi, mine_t, mine_u), both joined in block
+// order.
+template <class T, class U, class Body>
+void in_blocks2(std::size_t n, std::size_t per_thread, std::vector<T>& out_t, std::vector<U>& out_u, Body&& body) {
+  const int blocks = block_count(n, per_thread);
+  std::vector<std::vector<T>> part_t(static_cast<std::size_t>(blocks));
+  std::vector<std::vector<U>> part_u(static_cast<std::size_t>(blocks));
+  for_blocks(n, blocks, [&](std::size_t b, std::size_t lo, std::size_t hi) {
+    std::vector<T>& mt = b == 0 ? out_t : part_t[b];
+    std::vector<U>& mu = b == 0 ? out_u : part_u[b];
+    mt.clear();
+    mu.clear();
+    body(lo, hi, mt, mu);
+  });
+  for (std::size_t blk = 1; blk < static_cast<std::size_t>(blocks); ++blk) {
+    out_t.insert(out_t.end(), part_t[blk].begin(), part_t[blk].end());
+    out_u.insert(out_u.end(), part_u[blk].begin(), part_u[blk].end());
+  }
+}
+
 }  // namespace mrf::detail

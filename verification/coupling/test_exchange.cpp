@@ -60,15 +60,20 @@ TEST(CouplingExchange, PairsAreTheSameOnAnyNumberOfThreads) {
   const auto dem = random_points(2500, -0.5 * c.box.gap, 0.5 * c.box.gap, c.box, 5);
   const int saved = omp_get_max_threads();
   omp_set_num_threads(1);
-  const auto one = coupling_pairs(dem, c.fluid.x, c.box, c.h);
+  std::vector<CouplingPair> one, many;
+  std::vector<Vec3> one_dw, many_dw;
+  coupling_pairs(dem, c.fluid.x, c.box, c.h, one, &one_dw);
+  ASSERT_EQ(one_dw.size(), one.size());
   for (int t : {2, 3}) {
     omp_set_num_threads(t);
-    const auto many = coupling_pairs(dem, c.fluid.x, c.box, c.h);
+    coupling_pairs(dem, c.fluid.x, c.box, c.h, many, &many_dw);
     ASSERT_EQ(many.size(), one.size()) << t << " threads";
+    ASSERT_EQ(many_dw.size(), one.size()) << t << " threads";
     for (std::size_t k = 0; k < one.size(); ++k) {
       ASSERT_EQ(many[k].i, one[k].i) << k;
       ASSERT_EQ(many[k].a, one[k].a) << k;
       ASSERT_EQ(many[k].w, one[k].w) << k;
+      ASSERT_EQ(many_dw[k], one_dw[k]) << k;
     }
   }
   omp_set_num_threads(saved);
@@ -84,7 +89,9 @@ TEST(CouplingExchange, PairsAreTheSameOnAnyNumberOfThreads) {
 TEST(CouplingExchange, ShepardSumsAreTheSameOnAnyNumberOfThreads) {
   const FluidCell c = make_cell();
   const auto dem = random_points(2500, -0.5 * c.box.gap, 0.5 * c.box.gap, c.box, 7);
-  const auto pairs = coupling_pairs(dem, c.fluid.x, c.box, c.h);
+  std::vector<CouplingPair> pairs;
+  std::vector<Vec3> dw;
+  coupling_pairs(dem, c.fluid.x, c.box, c.h, pairs, &dw);
   ASSERT_GT(pairs.size(), 3u * 8192u);
   const std::size_t na = c.fluid.size();
   std::vector<double> rho(na), eps(na);
@@ -101,7 +108,7 @@ TEST(CouplingExchange, ShepardSumsAreTheSameOnAnyNumberOfThreads) {
   auto all = [&](int t) {
     omp_set_num_threads(t);
     const ShepardField sh = shepard_interpolate(dem.size(), pairs, c.mass, rho, v, eps);
-    return std::make_tuple(sh, shepard_rate(pairs, c.mass, rho, v, sh, c_dem),
+    return std::make_tuple(sh, shepard_rate(pairs, dw, c.mass, rho, v, sh, c_dem),
                            generalised_buoyancy(dem.size(), pairs, c.mass, sh.s, acc, kVp));
   };
   const auto one = all(1);
@@ -137,9 +144,11 @@ TEST(CouplingExchange, ShepardRateIsTheTimeDerivativeOfTheInterpolant) {
     std::vector<double> rho(c.fluid.size()), eps(c.fluid.size(), 1.0);
     for (std::size_t a = 0; a < v.size(); ++a) v[a] = Vec3(g(gen), g(gen), g(gen)), rho[a] = 1000.0 * (1 + 0.1 * g(gen));
     for (auto& d : dir) d = Vec3(g(gen), g(gen), g(gen));
-    const auto pairs = coupling_pairs(dem, c.fluid.x, box, c.h);
+    std::vector<CouplingPair> pairs;
+    std::vector<Vec3> dw;
+    coupling_pairs(dem, c.fluid.x, box, c.h, pairs, &dw);
     const ShepardField at = shepard_interpolate(dem.size(), pairs, c.mass, rho, v, eps);
-    const std::vector<Vec3> rate = shepard_rate(pairs, c.mass, rho, v, at, dir);
+    const std::vector<Vec3> rate = shepard_rate(pairs, dw, c.mass, rho, v, at, dir);
     const double e = 2e-4 * kDx / 1.0;  // s: displacements of about 2e-4 dx at 1 m/s
     auto field_at = [&](double sign) {
       std::vector<Vec3> x = dem, xa = c.fluid.x;
@@ -198,17 +207,19 @@ TEST(CouplingExchange, CachedPairsEqualAFreshSearchAtEveryStep) {
         q.z() -= box.lz * std::floor(q.z() / box.lz);
       }
     };
-    std::vector<CouplingPair> cached;
+    std::vector<CouplingPair> cached, fresh;
+    std::vector<Vec3> cached_dw, fresh_dw;
     const int steps = 200;
     for (int step = 0; step < steps; ++step) {
       if (coupling_cache_stale(cache, dem, sph, box, c.h)) rebuild_coupling_cache(cache, dem, sph, box, c.h);
-      coupling_pairs_of(cache.candidates, dem, sph, box, c.h, cached);
-      const auto fresh = coupling_pairs(dem, sph, box, c.h);
+      coupling_pairs_of(cache.candidates, dem, sph, box, c.h, cached, &cached_dw);
+      coupling_pairs(dem, sph, box, c.h, fresh, &fresh_dw);
       ASSERT_EQ(cached.size(), fresh.size()) << "step " << step;
       for (std::size_t k = 0; k < fresh.size(); ++k) {
         ASSERT_EQ(cached[k].i, fresh[k].i) << k;
         ASSERT_EQ(cached[k].a, fresh[k].a) << k;
         ASSERT_EQ(cached[k].w, fresh[k].w) << k;
+        ASSERT_EQ(cached_dw[k], fresh_dw[k]) << k;
       }
       move(dem);
       move(sph);

@@ -58,7 +58,8 @@ void coupling_candidates(const std::vector<Vec3>& dem_x, const std::vector<Vec3>
 }
 
 void coupling_pairs_of(const std::vector<IndexPair>& candidates, const std::vector<Vec3>& dem_x,
-                       const std::vector<Vec3>& sph_x, const Box& box, double h, std::vector<CouplingPair>& out) {
+                       const std::vector<Vec3>& sph_x, const Box& box, double h, std::vector<CouplingPair>& out,
+                       std::vector<Vec3>* grad) {
   if (!(h > 0.0)) throw std::invalid_argument("coupling_pairs: smoothing length h must be > 0");
   const double rc = k_kernel_support * h, rc2 = rc * rc;
   // Every periodic image closer than rc is its own entry: along y (z) a
@@ -69,13 +70,17 @@ void coupling_pairs_of(const std::vector<IndexPair>& candidates, const std::vect
                                 std::to_string(box.ly) + " m, lz " + std::to_string(box.lz) + " m, 2h " +
                                 std::to_string(rc) + " m): a pair would interact through more than two images");
   const MinImageYZ mi(box);
+  const bool with_grad = grad != nullptr;
+  std::vector<Vec3> unused;
   // candidates in blocks (in_blocks), the pairs in candidate order. A pair
-  // in range is kept with its separation and r^2 first; the kernel then runs
-  // over all of a block's r^2 at once on the vector units (kernel_rows), and
-  // (dW/dr)/r scales the separation: the same numbers as KernelW per pair.
-  detail::in_blocks(candidates.size(), k_coupling_candidates_per_thread, out,
-            [&](std::size_t lo, std::size_t hi, std::vector<CouplingPair>& mine) {
+  // in range is kept with r^2 (and, for the gradient, its separation); the
+  // kernel then runs over all of a block's r^2 at once on the vector units
+  // (kernel_rows), and (dW/dr)/r scales the separation: the same numbers as
+  // KernelW per pair.
+  detail::in_blocks2(candidates.size(), k_coupling_candidates_per_thread, out, with_grad ? *grad : unused,
+            [&](std::size_t lo, std::size_t hi, std::vector<CouplingPair>& mine, std::vector<Vec3>& mine_dw) {
               mine.reserve(hi - lo);
+              if (with_grad) mine_dw.reserve(hi - lo);
               thread_local std::vector<double> r2s, ws, fs;
               r2s.clear();
               for (std::size_t c = lo; c < hi; ++c) {
@@ -85,7 +90,8 @@ void coupling_pairs_of(const std::vector<IndexPair>& candidates, const std::vect
                 const double dx = xi.x() - xa.x(), dx2 = dx * dx;
                 if (dx2 >= rc2) continue;  // x is not periodic: cheap rejection first
                 auto push = [&, i = i, a = a](double ey, double ez, double q2) {
-                  mine.push_back({i, a, 0.0, Vec3(dx, ey, ez)});
+                  mine.push_back({i, a, 0.0});
+                  if (with_grad) mine_dw.emplace_back(dx, ey, ez);
                   r2s.push_back(q2);
                 };
                 const double dy = mi.wrap_y(xi.y() - xa.y()), dz = mi.wrap_z(xi.z() - xa.z());
@@ -111,19 +117,18 @@ void coupling_pairs_of(const std::vector<IndexPair>& candidates, const std::vect
               ws.resize(m);
               fs.resize(m);
               kernel_rows(KernelW(h), r2s.data(), m, ws.data(), fs.data());
-              for (std::size_t p = 0; p < m; ++p) {
-                mine[p].w = ws[p];
-                mine[p].dw *= fs[p];
-              }
+              for (std::size_t p = 0; p < m; ++p) mine[p].w = ws[p];
+              if (with_grad)
+                for (std::size_t p = 0; p < m; ++p) mine_dw[p] *= fs[p];
             });
 }
 
 void coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x, const Box& box, double h,
-                    std::vector<CouplingPair>& out) {
+                    std::vector<CouplingPair>& out, std::vector<Vec3>* grad) {
   if (!(h > 0.0)) throw std::invalid_argument("coupling_pairs: smoothing length h must be > 0");  // named as h, not as the reach
   std::vector<IndexPair> candidates;
   coupling_candidates(dem_x, sph_x, box, k_kernel_support * h, candidates);
-  coupling_pairs_of(candidates, dem_x, sph_x, box, h, out);
+  coupling_pairs_of(candidates, dem_x, sph_x, box, h, out, grad);
 }
 
 bool coupling_cache_stale(const CouplingPairCache& cache, const std::vector<Vec3>& dem_x,
@@ -200,14 +205,18 @@ ShepardField shepard_interpolate(std::size_t n_dem, const std::vector<CouplingPa
   return out;
 }
 
-std::vector<Vec3> shepard_rate(const std::vector<CouplingPair>& pairs, double mass, const std::vector<double>& rho,
-                               const std::vector<Vec3>& v, const ShepardField& at, const std::vector<Vec3>& c) {
+std::vector<Vec3> shepard_rate(const std::vector<CouplingPair>& pairs, const std::vector<Vec3>& dw, double mass,
+                               const std::vector<double>& rho, const std::vector<Vec3>& v, const ShepardField& at,
+                               const std::vector<Vec3>& c) {
+  if (dw.size() != pairs.size())
+    throw std::logic_error("shepard_rate: " + std::to_string(dw.size()) + " kernel gradients for " +
+                           std::to_string(pairs.size()) + " pairs");
   std::vector<Vec3> out(at.u.size(), Vec3::Zero());
   by_dem_runs(pairs, [&](std::uint32_t i, std::size_t first, std::size_t last) {
     Vec3 oi = out[i];
     for (std::size_t q = first; q < last; ++q) {
       const CouplingPair& p = pairs[q];
-      oi += (mass / rho[p.a] * p.dw.dot(c[i] - v[p.a])) * (v[p.a] - at.u[i]);
+      oi += (mass / rho[p.a] * dw[q].dot(c[i] - v[p.a])) * (v[p.a] - at.u[i]);
     }
     out[i] = oi;
   });

@@ -50,7 +50,7 @@ void CoupledModel::inertialess_step() {
   // path is second order.
   std::vector<Vec3> v_p(n);
   for (std::size_t i = 0; i < n; ++i) v_p[i] = u_at_[i] + drift_.w0[i] + drift_.inv_gamma[i] * fc[i];
-  const std::vector<Vec3> sampled = shepard_rate(pairs_, fluid_.mass, fluid_.fluid.rho, fluid_.fluid.v, shepard_, v_p);
+  const std::vector<Vec3> sampled = shepard_rate(pairs_, pair_grads_, fluid_.mass, fluid_.fluid.rho, fluid_.fluid.v, shepard_, v_p);
   for (std::size_t i = 0; i < n; ++i) drift_.w1[i] += sampled[i];
   drift_.u = u_at_;
   const double dt = implicit_->advance(drift_, f, cell_.walls, cell_.box, time_, steps_);

@@ -198,7 +198,8 @@ void CoupledModel::update_coupling_pairs() {
     rebuild_coupling_cache(coupling_cache_, solid_, fluid_.fluid.x, cell_.box, fluid_.h);
     coupling_cache_time_ = time_;
   }
-  coupling_pairs_of(coupling_cache_.candidates, solid_, fluid_.fluid.x, cell_.box, fluid_.h, solid_pairs_);
+  coupling_pairs_of(coupling_cache_.candidates, solid_, fluid_.fluid.x, cell_.box, fluid_.h, solid_pairs_,
+                    implicit_ ? &pair_grads_ : nullptr);
   // The pairs come in index order, the mirrors' (i >= n) last: only that
   // tail is filtered, and the particles' pairs are its prefix, kept by a
   // swap once the porosity has read the mirrors.
@@ -212,6 +213,7 @@ void CoupledModel::update_coupling_pairs() {
                      solid_pairs_.end());
   PorosityField eps = porosity_at_fluid(fluid_.fluid.size(), sphere_volume(p_.radius), solid_pairs_);
   solid_pairs_.resize(static_cast<std::size_t>(n_real));
+  if (implicit_) pair_grads_.resize(static_cast<std::size_t>(n_real));  // the mirrors' gradients are not read
   pairs_.swap(solid_pairs_);
   fluid_.fluid.eps = std::move(eps.eps);
   sums_.eps_clamped = eps.clamped;

@@ -23,14 +23,14 @@
 
 namespace mrf {
 
-// One DEM-SPH pair within the kernel support 2h: W = W(|x_i - x_a|, h) (1/m^3)
-// and its gradient with respect to x_i, dw = W'(r) (x_i - x_a) / r (1/m^4),
-// of the image the pair is for.
+// One DEM-SPH pair within the kernel support 2h: W = W(|x_i - x_a|, h)
+// (1/m^3) of the image the pair is for. 16 bytes: every pass over the pairs
+// reads them, and only the inertialess step's shepard_rate needs the
+// gradient, which coupling_pairs_of gives beside them when asked.
 struct CouplingPair {
   std::uint32_t i;  // DEM particle
   std::uint32_t a;  // SPH particle
   double w;
-  Vec3 dw;
 };
 
 // All DEM-SPH pairs closer than 2h (cell lists, periodic in y and z). When
@@ -42,8 +42,9 @@ std::vector<CouplingPair> coupling_pairs(const std::vector<Vec3>& dem_x, const s
 // Same, into `out` (cleared; its capacity is reused). Pairs come sorted by
 // (DEM index i, SPH index a, image), so every sum over them has the same
 // order whether the pairs come from a fresh search or from candidates.
+// With `grad`, also each pair's kernel gradient (coupling_pairs_of).
 void coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x, const Box& box, double h,
-                    std::vector<CouplingPair>& out);
+                    std::vector<CouplingPair>& out, std::vector<Vec3>* grad = nullptr);
 
 // Verlet candidates: the (DEM i, SPH a) with a minimum-image distance below
 // `reach` (m), sorted by (i, a), into `out`.
@@ -51,9 +52,12 @@ void coupling_candidates(const std::vector<Vec3>& dem_x, const std::vector<Vec3>
                          double reach, std::vector<IndexPair>& out);
 // The pairs closer than 2h among the candidates, in their order (each image
 // its own entry, as coupling_pairs): equal to coupling_pairs bit for bit
-// when every pair within 2h is a candidate.
+// when every pair within 2h is a candidate. With `grad`, also each pair's
+// kernel gradient with respect to x_i, W'(r) (x_i - x_a) / r (1/m^4), of its
+// image, at the same index.
 void coupling_pairs_of(const std::vector<IndexPair>& candidates, const std::vector<Vec3>& dem_x,
-                       const std::vector<Vec3>& sph_x, const Box& box, double h, std::vector<CouplingPair>& out);
+                       const std::vector<Vec3>& sph_x, const Box& box, double h, std::vector<CouplingPair>& out,
+                       std::vector<Vec3>* grad = nullptr);
 
 // Verlet cache of the coupling pairs between two moving point sets (the DEM
 // particles with their wall mirrors, the SPH fluid), rebuilt by the bound
@@ -111,11 +115,13 @@ ShepardField shepard_interpolate(std::size_t n_dem, const std::vector<CouplingPa
 // changes at DEM particle i moving at c_i while the SPH particles move at
 // their velocities v_a (v_a and rho_a held): the exact time derivative
 //   du_i/dt = sum_a (m/rho_a) (v_a - u_i) (dw_ia . (c_i - v_a)) / s_i   (m/s^2),
-// with s and u from shepard_interpolate on the same pairs, mass, rho and v.
+// with s and u from shepard_interpolate on the same pairs, mass, rho and v,
+// and dw the pairs' kernel gradients (coupling_pairs_of's `grad`).
 // In a smooth flow it is (c_i - u_i) . grad u; it also holds the flicker of
 // the interpolant as the SPH particles stream past.
-std::vector<Vec3> shepard_rate(const std::vector<CouplingPair>& pairs, double mass, const std::vector<double>& rho,
-                               const std::vector<Vec3>& v, const ShepardField& at, const std::vector<Vec3>& c);
+std::vector<Vec3> shepard_rate(const std::vector<CouplingPair>& pairs, const std::vector<Vec3>& dw, double mass,
+                               const std::vector<double>& rho, const std::vector<Vec3>& v, const ShepardField& at,
+                               const std::vector<Vec3>& c);
 
 // Generalised buoyancy of the averaged equations (model A, REFERENCE §6):
 //   F_i = V_p (-grad p + div tau)_i = V_p sum_a (m/rho_a) W_ia (rho_a a_a) / s_i,

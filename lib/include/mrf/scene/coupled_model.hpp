@@ -183,6 +183,7 @@ class CoupledModel final : public Model {
   DemPairLists lists_;
   ForceBuffers buffers_;
   std::vector<CouplingPair> pairs_, solid_pairs_;  // real particles; with wall mirror images
+  std::vector<Vec3> pair_grads_;  // inertialess: the kernel gradient of each of pairs_ (shepard_rate)
   std::vector<Vec3> solid_;
   CouplingPairCache coupling_cache_;
   std::vector<std::uint32_t> mirrored_;  // the particles whose wall mirrors the cache holds
