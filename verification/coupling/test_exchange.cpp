@@ -52,6 +52,56 @@ TEST(CouplingExchange, PairsMatchBruteForce) {
   EXPECT_EQ(pairs.size(), brute_force_cross_pairs(dem, c.fluid.x, c.box, 2.0 * c.h).size());
 }
 
+// Every pair and periodic image against an enumeration written out here,
+// entry for entry and bit for bit: (i, a) in order, each image after the
+// minimum one (y, z, both), W and its gradient from KernelW. In the default
+// box (one image per pair) and in boxes narrower than 4h along y, z and
+// both, as the paper cell is along y, with enough points that the vector
+// path, its one-at-a-time fallback and the tail all run. A wrong image
+// order, a lost image or another rounding of the minimum image fails.
+TEST(CouplingExchange, PairsAndImagesMatchAnEnumerationBitForBit) {
+  for (const Box& box : {Box{24 * kDx, 12 * kDx, 12 * kDx}, Box{24 * kDx, 5 * kDx, 12 * kDx},
+                         Box{24 * kDx, 12 * kDx, 5 * kDx}, Box{24 * kDx, 3 * kDx, 4 * kDx}}) {
+    const FluidCell c = make_cell(box);
+    const auto dem = random_points(301, -0.5 * box.gap, 0.5 * box.gap, box, 13);
+    std::vector<CouplingPair> pairs;
+    std::vector<Vec3> dw;
+    coupling_pairs(dem, c.fluid.x, box, c.h, pairs, &dw);
+    const KernelW k(c.h);
+    const double rc = k_kernel_support * c.h, rc2 = rc * rc;
+    const MinImageYZ mi(box);
+    std::size_t e = 0, images = 0;
+    for (std::uint32_t i = 0; i < dem.size(); ++i)
+      for (std::uint32_t a = 0; a < c.fluid.size(); ++a) {
+        const Vec3 d = mi.delta(dem[i], c.fluid.x[a]);
+        std::vector<Vec3> seps{d};  // the minimum image, then the next ones across y, z, both
+        const double oy = d.y() - std::copysign(box.ly, d.y()), oz = d.z() - std::copysign(box.lz, d.z());
+        const bool ky = box.ly < 2 * rc, kz = box.lz < 2 * rc;
+        if (ky) seps.emplace_back(d.x(), oy, d.z());
+        if (kz) seps.emplace_back(d.x(), d.y(), oz);
+        if (ky && kz) seps.emplace_back(d.x(), oy, oz);
+        for (std::size_t m = 0; m < seps.size(); ++m) {
+          const Vec3& s = seps[m];
+          const double r2 = s.x() * s.x() + s.y() * s.y() + s.z() * s.z();
+          if (!(r2 < rc2)) continue;
+          ASSERT_LT(e, pairs.size());
+          ASSERT_EQ(pairs[e].i, i) << "entry " << e;
+          ASSERT_EQ(pairs[e].a, a) << "entry " << e;
+          const double r = std::sqrt(r2);
+          ASSERT_EQ(pairs[e].w, k(r)) << "entry " << e;
+          ASSERT_EQ(dw[e], (s * k.dwdr_over_r(r)).eval()) << "entry " << e;
+          images += m > 0;
+          ++e;
+        }
+      }
+    EXPECT_EQ(e, pairs.size());
+    EXPECT_GT(e, 2000u);
+    if (box.ly < 4 * c.h || box.lz < 4 * c.h) {
+      EXPECT_GT(images, 50u) << "a narrow box has second images";
+    }
+  }
+}
+
 // The search runs in blocks of DEM particles on threads; the list is the
 // same, entry for entry and in the same order, on 1, 2 and 3 threads (and
 // above the block threshold, 1000 DEM particles).

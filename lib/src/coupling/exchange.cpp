@@ -11,6 +11,7 @@
 #include "mrf/neighbors/verlet_list.hpp"
 #include "parallel_blocks.hpp"
 #include "coupling/dem_runs.hpp"
+#include "coupling/pairs_simd.hpp"
 
 namespace mrf {
 
@@ -72,55 +73,28 @@ void coupling_pairs_of(const std::vector<IndexPair>& candidates, const std::vect
   const MinImageYZ mi(box);
   const bool with_grad = grad != nullptr;
   std::vector<Vec3> unused;
-  // candidates in blocks (in_blocks), the pairs in candidate order. A pair
-  // in range is kept with r^2 (and, for the gradient, its separation); the
-  // kernel then runs over all of a block's r^2 at once on the vector units
-  // (kernel_rows), and (dW/dr)/r scales the separation: the same numbers as
-  // KernelW per pair.
+  // candidates in blocks (in_blocks2), the pairs in candidate order: the
+  // range test on the vector units (pairs_simd.hpp), then the kernel over all
+  // of a block's r^2 at once (kernel_rows), and (dW/dr)/r scales the
+  // separation: the same numbers as KernelW per pair.
   detail::in_blocks2(candidates.size(), k_coupling_candidates_per_thread, out, with_grad ? *grad : unused,
-            [&](std::size_t lo, std::size_t hi, std::vector<CouplingPair>& mine, std::vector<Vec3>& mine_dw) {
-              mine.reserve(hi - lo);
-              if (with_grad) mine_dw.reserve(hi - lo);
-              thread_local std::vector<double> r2s, ws, fs;
-              r2s.clear();
-              for (std::size_t c = lo; c < hi; ++c) {
-                const auto [i, a] = candidates[c];
-                const Vec3& xi = dem_x[i];
-                const Vec3& xa = sph_x[a];
-                const double dx = xi.x() - xa.x(), dx2 = dx * dx;
-                if (dx2 >= rc2) continue;  // x is not periodic: cheap rejection first
-                auto push = [&, i = i, a = a](double ey, double ez, double q2) {
-                  mine.push_back({i, a, 0.0});
-                  if (with_grad) mine_dw.emplace_back(dx, ey, ez);
-                  r2s.push_back(q2);
-                };
-                const double dy = mi.wrap_y(xi.y() - xa.y()), dz = mi.wrap_z(xi.z() - xa.z());
-                const double r2 = dx2 + dy * dy + dz * dz;
-                if (r2 < rc2) push(dy, dz, r2);
-                if (!ky && !kz) continue;
-                // Along a periodic axis of length l >= rc at most the next image on
-                // the other side, d - sign(d) l, is also closer than rc (|d| <= l/2),
-                // and only when l < 2 rc.
-                const double oy = ky ? dy - std::copysign(box.ly, dy) : 0.0, oz = kz ? dz - std::copysign(box.lz, dz) : 0.0;
-                const bool y2 = ky && oy * oy < rc2, z2 = kz && oz * oz < rc2;
-                auto image = [&](double ey, double ez) {
-                  const double q2 = dx2 + ey * ey + ez * ez;
-                  if (q2 < rc2) push(ey, ez, q2);
-                };
-                if (y2) image(oy, dz);
-                if (z2) {
-                  image(dy, oz);
-                  if (y2) image(oy, oz);
-                }
-              }
-              const std::size_t m = r2s.size();
-              ws.resize(m);
-              fs.resize(m);
-              kernel_rows(KernelW(h), r2s.data(), m, ws.data(), fs.data());
-              for (std::size_t p = 0; p < m; ++p) mine[p].w = ws[p];
-              if (with_grad)
-                for (std::size_t p = 0; p < m; ++p) mine_dw[p] *= fs[p];
-            });
+                     [&](std::size_t lo, std::size_t hi, std::vector<CouplingPair>& mine, std::vector<Vec3>& mine_dw) {
+                       thread_local detail::InRange in;
+                       thread_local std::vector<double> ws, fs;
+                       const detail::InRangeQuery q{candidates.data(), dem_x.data()->data(), sph_x.data()->data(),
+                                                    box.ly, box.lz, mi.inv_ly, mi.inv_lz, rc2, ky, kz, with_grad};
+                       detail::in_range_candidates(q, lo, hi, in);
+                       const std::size_t m = in.n;
+                       if (ws.size() < m) ws.resize(m), fs.resize(m);
+                       kernel_rows(KernelW(h), in.r2.data(), m, ws.data(), fs.data());
+                       mine.reserve(m);
+                       for (std::size_t p = 0; p < m; ++p)
+                         mine.push_back({static_cast<std::uint32_t>(in.ends[p]),
+                                         static_cast<std::uint32_t>(in.ends[p] >> 32), ws[p]});
+                       if (!with_grad) return;
+                       mine_dw.reserve(m);
+                       for (std::size_t p = 0; p < m; ++p) mine_dw.push_back(Vec3(in.sx[p], in.sy[p], in.sz[p]) * fs[p]);
+                     });
 }
 
 void coupling_pairs(const std::vector<Vec3>& dem_x, const std::vector<Vec3>& sph_x, const Box& box, double h,
