@@ -81,8 +81,9 @@ void coupling_pairs_of(const std::vector<IndexPair>& candidates, const std::vect
                      [&](std::size_t lo, std::size_t hi, std::vector<CouplingPair>& mine, std::vector<Vec3>& mine_dw) {
                        thread_local detail::InRange in;
                        thread_local std::vector<double> ws, fs;
-                       const detail::InRangeQuery q{candidates.data(), dem_x.data()->data(), sph_x.data()->data(),
-                                                    box.ly, box.lz, mi.inv_ly, mi.inv_lz, rc2, ky, kz, with_grad};
+                       const detail::InRangeQuery q{candidates.data(), reinterpret_cast<const double*>(dem_x.data()),
+                                                    reinterpret_cast<const double*>(sph_x.data()), box.ly, box.lz,
+                                                    mi.inv_ly, mi.inv_lz, rc2, ky, kz, with_grad};
                        detail::in_range_candidates(q, lo, hi, in);
                        const std::size_t m = in.n;
                        if (ws.size() < m) ws.resize(m), fs.resize(m);

@@ -18,6 +18,7 @@
 #include <hwy/highway.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -27,6 +28,8 @@
 
 static_assert(sizeof(mrf::IndexPair) == sizeof(std::uint64_t) && offsetof(mrf::IndexPair, first) == 0,
               "a candidate is read as one 64-bit lane, DEM index in the low half (little-endian)");
+static_assert(sizeof(mrf::Vec3) == 3 * sizeof(double), "positions are read as packed x, y, z");
+static_assert(std::endian::native == std::endian::little, "the DEM index is the low half of a candidate's lane");
 
 HWY_BEFORE_NAMESPACE();
 namespace mrf {
