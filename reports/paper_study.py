@@ -283,6 +283,20 @@ def old_claims(crit, small_crit, phi, small_m, pstate=None):
     return lines
 
 
+def against_small(q, small_k, phi, small_m):
+    """A seed-combined paper-cell point in phi mu0 M^2 (value, error) and the
+    two table cells that set it against the small cell at the same Mn
+    (its value, the difference in combined standard errors)."""
+    sc = phi * MU0 * q["magnetization"] ** 2
+    t, e = q["stress"] / sc, q["err"] / sc
+    sm = small_k.get(q["mason"])
+    if not sm:
+        return t, e, "– | –"
+    ss = phi * MU0 * small_m ** 2
+    st, se = sm[0] / ss, sm[1] / ss
+    return t, e, f"{st:.4f} ± {se:.4f} | {(t - st) / math.hypot(e, se):+.1f}"
+
+
 def answers(crit, small, phi, small_m, pstate, unsteady, claim_lines, cost_line, conv_path):
     """The section a reader wants first: the three models' stress at Mn 1e-2
     and 1 on the paper cell and the small cell, how settled each number is,
@@ -305,15 +319,7 @@ def answers(crit, small, phi, small_m, pstate, unsteady, claim_lines, cost_line,
             q = next((q for q in crit["models"][k]["points"] if mkey(q["mason"]) == mkey(m)), None)
             if q is None:
                 continue
-            sc = phi * MU0 * q["magnetization"] ** 2
-            t, e = q["stress"] / sc, q["err"] / sc
-            sm = small[k].get(q["mason"])
-            if sm:
-                ss = phi * MU0 * small_m ** 2
-                st, se = sm[0] / ss, sm[1] / ss
-                cmp_ = f"{st:.4f} ± {se:.4f} | {(t - st) / math.hypot(e, se):+.1f}"
-            else:
-                cmp_ = "– | –"
+            t, e, cmp_ = against_small(q, small[k], phi, small_m)
             c = pstate.get((k, mkey(m)), [0, 0, 0])
             part = f"{c[2] - c[0] - c[1]} pass, {c[0]} fail, {c[1]} untested"
             lines.append(f"| {k} | {m:g} | {t:.4f} ± {e:.4f} | {cmp_} | {unsteady.get((k, mkey(m)), 0)} of "
@@ -516,15 +522,8 @@ def main(argv):
     for k in models:
         for q in crit["models"][k]["points"]:
             s = phi * MU0 * q["magnetization"] ** 2
-            t, e = q["stress"] / s, q["err"] / s
+            t, e, cmp_ = against_small(q, small[k], phi, small_m)
             ratio = q["seed_scatter"] / q["within_err"] if q["within_err"] > 0 and q["seeds"] > 1 else float("nan")
-            sm = small[k].get(q["mason"])
-            if sm:
-                ss = phi * MU0 * small_m ** 2
-                st, se = sm[0] / ss, sm[1] / ss
-                cmp_ = f"{st:.4f} ± {se:.4f} | {(t - st) / math.hypot(e, se):+.1f}"
-            else:
-                cmp_ = "– | –"
             ef = f"{e:.4f}" if e >= 1e-4 else f"{e:.1e}"
             rf = "– (one seed: no scatter)" if math.isnan(ratio) else f"{ratio:.2f}"
             lines.append(f"| {k} | {q['mason']:g} | {q['seeds']} | {t:.4f} ± {ef} | "
