@@ -80,6 +80,11 @@ def steady(r):
     return abs(z) < DRIFT_Z and d < MSER_MAX
 
 
+def fe(e):
+    """An error bar in phi mu0 M^2: four decimals, or two digits when smaller."""
+    return f"{e:.4f}" if e >= 1e-4 else f"{e:.1e}"
+
+
 def particle_rule(r):
     """'ok', 'untested' (a summary without the version-2 estimate) or the
     reasons the run's particle part fails the session-25 rule."""
@@ -156,17 +161,20 @@ def two_paths(argv, here, crit, phi, models):
     fixed = json.load(open(crit_path))  # the seed-combined points, as for the realistic path
     dimless = {}  # St and Re_p of each (model, Mn), from the runs
     unsteady = defaultdict(int)  # runs failing a steadiness test, per (model, Mn)
-    for r in read_rows(path):
-        if r["status"] == "ok":
-            dimless[(r["model"], float(r["mason"]))] = (num(r, "stokes_number"), num(r, "reynolds_number"))
-            unsteady[(r["model"], float(r["mason"]))] += 0 if steady(r) else 1
+    fixed_rows = [r for r in read_rows(path) if r["status"] == "ok"]
+    pstate = particle_state(fixed_rows)
+    for r in fixed_rows:
+        dimless[(r["model"], float(r["mason"]))] = (num(r, "stokes_number"), num(r, "reynolds_number"))
+        unsteady[(r["model"], float(r["mason"]))] += 0 if steady(r) else 1
     lines = ["## Two paths to a Mason number", "",
              "The realistic path (gdot = 1e3 1/s, M set by Mn: St and Re_p about 1e-4) against a fixed "
              "M = 1 MA/m with Mn set by the shear rate (experiments/sweeps/paper_fixed_m.toml: St = 0.30 Mn, "
              "Re_p = 0.175 Mn). Total wall stress / (phi mu0 M^2), seed-combined by mrf criterion as the "
              "realistic path is; the difference in combined standard errors. Where it is large, the model's "
              "behaviour at that Mn on the fixed-M path is inertia, not rheology. Seeds: how many, and in brackets "
-             "how many of them fail a steadiness test (after their one re-run, experiments/sweeps/paper_fixed_m.toml).", "",
+             "how many of them fail a steadiness test (after their one re-run, experiments/sweeps/paper_fixed_m.toml); "
+             "after the fixed-M particle part, how many runs fail the particle-part rule or predate it (steadiness "
+             "section).", "",
              "| model | Mn | seeds (fixed M) | fixed M | St, Re_p | realistic | fixed - realistic (sigma) | "
              "particle part: fixed M | realistic |",
              "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
@@ -178,16 +186,17 @@ def two_paths(argv, here, crit, phi, models):
             pt = (f["stress"] - f["stress_fluid"]) / sc
             st, re = dimless.get((k, f["mason"]), (float("nan"), float("nan")))
             q = real.get((k, f["mason"]))
+            pnote = particle_note(pstate.get((k, mkey(f["mason"]))))
             if q:
                 sr = phi * MU0 * q["magnetization"] ** 2
                 rt, re_ = q["stress"] / sr, q["err"] / sr
-                cmp_ = (f"{rt:.4f} ± {re_:.4f} | {(t - rt) / math.hypot(e, re_):+.1f} | {pt:.4f} ± {e:.4f} | "
-                        f"{(q['stress'] - q['stress_fluid']) / sr:.4f} ± {re_:.4f}")
+                cmp_ = (f"{rt:.4f} ± {fe(re_)} | {(t - rt) / math.hypot(e, re_):+.1f} | {pt:.4f} ± {fe(e)}{pnote} | "
+                        f"{(q['stress'] - q['stress_fluid']) / sr:.4f} ± {fe(re_)}")
             else:
-                cmp_ = f"– | – | {pt:.4f} ± {e:.4f} | –"
+                cmp_ = f"– | – | {pt:.4f} ± {fe(e)}{pnote} | –"
             bad = unsteady.get((k, f["mason"]), 0)
             seeds = f"{f['seeds']}" + (f" ({bad} unsteady)" if bad else "")
-            lines.append(f"| {k} | {f['mason']:g} | {seeds} | {t:.4f} ± {e:.4f} | {st:.2g}, {re:.2g} | {cmp_} |")
+            lines.append(f"| {k} | {f['mason']:g} | {seeds} | {t:.4f} ± {fe(e)} | {st:.2g}, {re:.2g} | {cmp_} |")
     lines.append("")
     return lines
 
@@ -294,7 +303,7 @@ def against_small(q, small_k, phi, small_m):
         return t, e, "– | –"
     ss = phi * MU0 * small_m ** 2
     st, se = sm[0] / ss, sm[1] / ss
-    return t, e, f"{st:.4f} ± {se:.4f} | {(t - st) / math.hypot(e, se):+.1f}"
+    return t, e, f"{st:.4f} ± {fe(se)} | {(t - st) / math.hypot(e, se):+.1f}"
 
 
 def answers(crit, small, phi, small_m, pstate, unsteady, claim_lines, cost_line, conv_path):
@@ -322,7 +331,7 @@ def answers(crit, small, phi, small_m, pstate, unsteady, claim_lines, cost_line,
             t, e, cmp_ = against_small(q, small[k], phi, small_m)
             c = pstate.get((k, mkey(m)), [0, 0, 0])
             part = f"{c[2] - c[0] - c[1]} pass, {c[0]} fail, {c[1]} untested"
-            lines.append(f"| {k} | {m:g} | {t:.4f} ± {e:.4f} | {cmp_} | {unsteady.get((k, mkey(m)), 0)} of "
+            lines.append(f"| {k} | {m:g} | {t:.4f} ± {fe(e)} | {cmp_} | {unsteady.get((k, mkey(m)), 0)} of "
                          f"{q['seeds']} | {part} |")
     lines.append("")
     if os.path.exists(conv_path):
@@ -524,7 +533,7 @@ def main(argv):
             s = phi * MU0 * q["magnetization"] ** 2
             t, e, cmp_ = against_small(q, small[k], phi, small_m)
             ratio = q["seed_scatter"] / q["within_err"] if q["within_err"] > 0 and q["seeds"] > 1 else float("nan")
-            ef = f"{e:.4f}" if e >= 1e-4 else f"{e:.1e}"
+            ef = fe(e)
             rf = "– (one seed: no scatter)" if math.isnan(ratio) else f"{ratio:.2f}"
             lines.append(f"| {k} | {q['mason']:g} | {q['seeds']} | {t:.4f} ± {ef} | "
                          f"{(q['stress'] - q['stress_fluid']) / s:.4f} ± {ef}{particle_note(pstate.get((k, mkey(q['mason']))))} | "
