@@ -15,6 +15,7 @@ usage: paper_study.py SWEEP_DIR OUT_DIR [--small reports/study/flow_curves.csv]
                       [--small-criterion reports/study/criterion_default.json]
                       [--reanalysed reports/study/paper/reanalysed.json]
                       [--convergence reports/study/paper/convergence.md]
+                      [--low-mn reports/study/paper/low_mn_sweep.csv]
 
 The fixed-M path (experiments/sweeps/paper_fixed_m.toml, collected with
 `mrf sweep ... --archive reports/study/paper/fixed_m_points --collect`, then
@@ -35,6 +36,9 @@ steadiness, listed under the steadiness table with what their re-runs gave.
 --reanalysed: `mrf reanalyse` records of archived runs (scripts/paper_interim.py
 writes them from the archive's window_series.csv files), for a post-hoc
 reading of the particle-part rule on runs that carry the plain estimate.
+--low-mn: model 1 at Mn 3e-4 (experiments/sweeps/paper_low_mn.toml, collected
+from reports/study/paper/low_mn_points by scripts/paper_interim.py), read
+by the rule that sweep file fixed before its runs.
 --convergence: the convergence table (reports/paper_convergence.py), whose
 largest-lever lines the opening section repeats.
 --small-criterion: mrf criterion's output for the small-cell study, whose
@@ -415,6 +419,58 @@ def theory_and_experiment(crit, phi, expt, aqs_quote):
     return lines
 
 
+def low_mn(argv, here, crit, phi, aqs_quote):
+    """Model 1 at Mn 3e-4 (experiments/sweeps/paper_low_mn.toml), read as that
+    file fixed before its runs: the particle part's slope s from Mn 1e-3
+    (the realistic sweep's point) within 2 standard errors of 0 is a
+    plateau, above it a fall toward the quasi-static value, below a rise."""
+    path = arg(argv, "--low-mn", os.path.join(here, "study", "paper", "low_mn_sweep.csv"))
+    if not os.path.exists(path):
+        return []
+    rows = [r for r in read_rows(path) if r["status"] == "ok" and r["model"] == "dem_stokes"]
+    base = next((q for q in crit["models"].get("dem_stokes", {}).get("points", []) if mkey(q["mason"]) == 1e-3), None)
+    lines = ["## Model 1 below Mn 1e-3: is there a plateau?", "",
+             "experiments/sweeps/paper_low_mn.toml: model 1, Mn = 3e-4 on the realistic path, three seeds; its "
+             "reading was fixed in that file before the runs: the slope s of the particle part "
+             "tau_p/(phi mu0 M^2) from Mn 1e-3 within 2 standard errors of 0 is a plateau (a dynamic yield "
+             "stress), above that the stress falls toward the quasi-static value, below it rises. Errors: "
+             "max(within-run, seed scatter / sqrt(n)); each run also under the steadiness tests and the "
+             "particle-part rule.", ""]
+    if not rows or base is None:
+        return lines + [f"No run has finished yet ({len(rows)} of 3).", ""]
+    n = len(rows)
+    sc = [phi * MU0 * num(r, "magnetization") ** 2 for r in rows]
+    vals = [(num(r, "stress_total") - num(r, "stress_fluid")) / c for r, c in zip(rows, sc)]
+    errs = [num(r, "stress_total_err") / c for r, c in zip(rows, sc)]
+    mean = sum(vals) / n
+    within = math.sqrt(sum(e * e for e in errs)) / n
+    scatter = statistics.stdev(vals) / math.sqrt(n) if n > 1 else 0.0
+    err = max(within, scatter)
+    bs = phi * MU0 * base["magnetization"] ** 2
+    bv, be = (base["stress"] - base["stress_fluid"]) / bs, base["err"] / bs
+    lr = math.log(1e-3 / 3e-4)
+    slope, slope_err = math.log(bv / mean) / lr, math.hypot(err / mean, be / bv) / lr
+    verdict = ("a plateau" if abs(slope) <= 2 * slope_err else
+               "falls toward the quasi-static value" if slope > 0 else "rises as Mn falls")
+    bad = [r["seed"] for r in rows if not steady(r)]
+    pfail = [r["seed"] for r in rows if particle_rule(r) not in ("ok", "untested")]
+    lines += ["| Mn | seeds | particle part | note |", "|---:|---:|---:|---|",
+              f"| 3e-4 | {n} | {mean:.4f} ± {fe(err)} | seed scatter / within-run "
+              f"{(scatter / within if within > 0 else float('nan')):.2f}"
+              + (f"; not steady: seeds {', '.join(bad)}" if bad else "")
+              + (f"; particle-part rule not passed: seeds {', '.join(pfail)}" if pfail else "")
+              + ("; runs without the version-2 estimate (the rule untested)"
+                 if any(particle_rule(r) == "untested" for r in rows) else "") + " |",
+              f"| 1e-3 | {base['seeds']} | {bv:.4f} ± {fe(be)} | the realistic sweep |"]
+    if math.isfinite(aqs_quote[0]):
+        lines.append(f"| 0 (AQS) | {aqs_quote[2]} | {aqs_quote[0]:.4f} ± {fe(aqs_quote[1])} | quasi-static limit |")
+    lines += ["", f"s (3e-4 to 1e-3) = {slope:+.3f} ± {slope_err:.3f}: by the reading fixed in advance, the particle "
+              f"stress **{verdict}**" + (f" ({n} of 3 seeds so far: provisional)" if n < 3 else "")
+              + (" (with runs that fail a steadiness test or the particle-part rule: read with that caveat)"
+                 if bad or pfail else "") + ".", ""]
+    return lines
+
+
 def sweep_cost(rows, firsts):
     """The wall time of the whole sweep: every run that counts, plus the
     first runs (summaries) that the steadiness re-runs replaced."""
@@ -728,6 +784,7 @@ def main(argv):
                      f"{pw['exponent']:.2f} ± {pw['exponent_err']:.2f} | {pw['chi2_dof']:.2g} | {note} |")
     lines.append("")
     lines += theory_and_experiment(crit, phi, expt, aqs_quote)
+    lines += low_mn(argv, here, crit, phi, aqs_quote)
     small_crit_path = arg(argv, "--small-criterion", os.path.join(here, "study", "criterion_default.json"))
     small_crit = json.load(open(small_crit_path)) if os.path.exists(small_crit_path) else None
     claims = old_claims(crit, small_crit, phi, small_m, particle_state(rows))

@@ -112,6 +112,13 @@ def main():
             shutil.copy(os.path.join(out, "criterion.json"), os.path.join(paper, crit_name))
         n = reanalysed(mrf, f"{paper}/points", os.path.join(paper, "reanalysed.json"))
         print(f"paper_realistic: {n} archived runs re-analysed from their window series")
+        # model 1 below Mn 1e-3 (no re-run rules: collected as it stands)
+        if os.path.isdir(f"{paper}/low_mn_points"):
+            out = os.path.join("out", "sweeps", "paper_low_mn_interim")
+            shutil.rmtree(out, ignore_errors=True)
+            subprocess.run([mrf, "sweep", os.path.join(sweeps, "paper_low_mn.toml"), "--out", out, "--archive",
+                            f"{paper}/low_mn_points", "--collect", "--quiet"], check=True)
+            shutil.copy(os.path.join(out, "sweep.csv"), os.path.join(paper, "low_mn_sweep.csv"))
         # the convergence variants against the realistic path's seed means
         pending = interim_toml(os.path.join(sweeps, "paper_convergence.toml"), f"{paper}/convergence/points", tmp)
         print(f"paper_convergence: re-runs pending: {', '.join(pending) if pending else 'none'}")

@@ -88,10 +88,34 @@ def main(argv):
     py = sys.executable
     if subprocess.run([py, "-c", "import matplotlib"], capture_output=True).returncode != 0:
         py = "/usr/bin/python3"
-    subprocess.run([py, os.path.join(root, "reports", "paper_study.py"), sweep, out,
-                    "--small", none, "--quasistatic", none, "--fixed-m", none, "--first-runs", none,
-                    "--small-criterion", os.path.join(sweep, "criterion.json"), "--reanalysed", late], check=True, stdout=subprocess.DEVNULL)
-    md = open(os.path.join(out, "paper.md")).read()
+    # Model 1 at Mn 3e-4 (the low-Mn sweep): the synthetic particle stress c_1,
+    # flat, must read as a plateau; half of it as a fall toward the
+    # quasi-static value (slope ln 2 / ln(10/3) = +0.58).
+    def low_mn_csv(name, factor):
+        path = os.path.join(work, name)
+        mn = 3e-4
+        m = math.sqrt(9 * ETA * GDOT / (2 * MU0 * mn))
+        scale = PHI * MU0 * m * m
+        c = MODELS["dem_stokes"][0] * factor
+        with open(path, "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(COLUMNS)
+            for seed in (1, 2, 3):
+                tau = c * scale * (1 + 0.001 * (seed - 2)) + ETA * GDOT
+                w.writerow(["dem_stokes", mn, seed, "ok", GDOT, 12, 4, repr(tau), repr(0.001 * c * scale), 0.1, 0.0,
+                            repr(ETA * GDOT), repr(tau), 4125, 100.0, 1e-4, 6e-5, repr(m), PHI, ETA, 1000.0, 1.5e-4,
+                            2.5e-6, 1, "", 0.5, ""])
+        return path
+
+    def report(out_dir, low):
+        subprocess.run([py, os.path.join(root, "reports", "paper_study.py"), sweep, out_dir,
+                        "--small", none, "--quasistatic", none, "--fixed-m", none, "--first-runs", none,
+                        "--small-criterion", os.path.join(sweep, "criterion.json"), "--reanalysed", late,
+                        "--low-mn", low], check=True, stdout=subprocess.DEVNULL)
+        return open(os.path.join(out_dir, "paper.md")).read()
+
+    md = report(out, low_mn_csv("low_flat.csv", 1.0))
+    md_fall = report(os.path.join(work, "report_fall"), low_mn_csv("low_fall.csv", 0.5))
     failures = []
 
     def check(what, got, want, tol):
@@ -180,6 +204,10 @@ def main(argv):
         failures.append(f"{len(lows)} lowest-Mn rows in the theory section, want {len(MODELS)}")
     for line, (k, (c, _)) in zip(lows, MODELS.items()):
         check(f"theory section, {k} particle part", float(value.match(line.split("|")[2].strip()).group(1)), c, 1e-4)
+    for text, want in ((md, "**a plateau**"), (md_fall, "**falls toward the quasi-static value**")):
+        line = [x for x in text.splitlines() if x.startswith("s (3e-4 to 1e-3)")]
+        if not line or want not in line[0]:
+            failures.append(f"low-Mn reading: {line[:1]}, want {want}")
     for f in failures:
         print("FAIL:", f)
     print(f"paper report check: {len(failures)} failure(s)")
