@@ -310,7 +310,7 @@ def against_small(q, small_k, phi, small_m):
     return t, e, f"{st:.4f} ± {fe(se)} | {(t - st) / math.hypot(e, se):+.1f}"
 
 
-def answers(crit, small, phi, small_m, pstate, unsteady, claim_lines, cost_line, conv_path):
+def answers(crit, small, phi, small_m, pstate, unsteady, claim_lines, cost_line, conv_path, extra=()):
     """The section a reader wants first: the three models' stress at Mn 1e-2
     and 1 on the paper cell and the small cell, how settled each number is,
     the largest numerical lever (the convergence table), what the whole sweep
@@ -360,7 +360,7 @@ def answers(crit, small, phi, small_m, pstate, unsteady, claim_lines, cost_line,
                          "lowest Mn is " + "; ".join(f"{c[0]} s = {c[4]}, {'flat' if c[6] == 'yes' else 'not flat'}"
                                                      for c in flat))
         lines.append("")
-    lines += [cost_line, ""]
+    lines += [x for x in extra if x] + [cost_line, ""]
     return lines
 
 
@@ -450,7 +450,7 @@ def low_mn(argv, here, crit, phi, aqs_quote):
     bv, be = (base["stress"] - base["stress_fluid"]) / bs, base["err"] / bs
     lr = math.log(1e-3 / 3e-4)
     slope, slope_err = math.log(bv / mean) / lr, math.hypot(err / mean, be / bv) / lr
-    verdict = ("a plateau" if abs(slope) <= 2 * slope_err else
+    verdict = ("is flat (a plateau)" if abs(slope) <= 2 * slope_err else
                "falls toward the quasi-static value" if slope > 0 else "rises as Mn falls")
     bad = [r["seed"] for r in rows if not steady(r)]
     pfail = [r["seed"] for r in rows if particle_rule(r) not in ("ok", "untested")]
@@ -784,7 +784,8 @@ def main(argv):
                      f"{pw['exponent']:.2f} ± {pw['exponent_err']:.2f} | {pw['chi2_dof']:.2g} | {note} |")
     lines.append("")
     lines += theory_and_experiment(crit, phi, expt, aqs_quote)
-    lines += low_mn(argv, here, crit, phi, aqs_quote)
+    low = low_mn(argv, here, crit, phi, aqs_quote)
+    lines += low
     small_crit_path = arg(argv, "--small-criterion", os.path.join(here, "study", "criterion_default.json"))
     small_crit = json.load(open(small_crit_path)) if os.path.exists(small_crit_path) else None
     claims = old_claims(crit, small_crit, phi, small_m, particle_state(rows))
@@ -794,8 +795,9 @@ def main(argv):
     for r in rows:
         unsteady[(r["model"], mkey(r["mason"]))] += 0 if steady(r) else 1
     cost = next((x for x in lines if x.startswith("Whole-sweep wall time")), "")
+    plateau = [f"Model 1 below Mn 1e-3 (its section below): {x}" for x in low if x.startswith("s (3e-4 to 1e-3)")]
     head = answers(crit, small, phi, small_m, particle_state(rows), unsteady, claims, cost,
-                   arg(argv, "--convergence", os.path.join(here, "study", "paper", "convergence.md")))
+                   arg(argv, "--convergence", os.path.join(here, "study", "paper", "convergence.md")), plateau)
     at = lines.index("![stress](stress_vs_mason.png)") + 2
     lines[at:at] = head
     with open(os.path.join(out, "paper.md"), "w") as f:
