@@ -108,9 +108,12 @@ namespace {
 // (entries e, e+1, e+2, e+3 mod 4), added pairwise at the end: one sum
 // alone is a chain of dependent adds, which held the loop to one entry per
 // add latency (perf: 90 % of its samples on the add). The order is fixed by the pairs alone, so the
-// result does not depend on the thread count (-ffp-contract=off under
-// -std=c++20 keeps the products unfused). Cloned for AVX2 and the
-// baseline, chosen when the program loads.
+// result does not depend on the thread count. Cloned for AVX2 and the
+// baseline, chosen when the program loads; neither clone has FMA, so a
+// product and its add stay two roundings on both (GCC would fuse them where
+// FMA is enabled: its C++ default is -ffp-contract=fast). An AVX-512 clone,
+// and a Highway version with two entries per 512-bit register, were slower
+// (bench_fluid_response 359 -> 364 and 378 us, session 25).
 __attribute__((target_clones("avx2", "default"))) void gather4(std::size_t rows, const std::uint32_t* row_of,
                                                                  const std::uint32_t* start, const std::uint32_t* col,
                                                                  const double* w, const double* in, double* out,
