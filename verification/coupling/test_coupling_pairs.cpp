@@ -20,9 +20,7 @@
 namespace mrf {
 namespace {
 
-using test::kDx;
-using test::make_cell;
-using test::random_points;
+using namespace mrf::test;  // the fluid cell and particles of support/coupling_cell.hpp
 
 TEST(CouplingExchange, PairsMatchBruteForce) {
   const FluidCell c = make_cell();

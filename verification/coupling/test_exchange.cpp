@@ -24,10 +24,7 @@
 namespace mrf {
 namespace {
 
-using test::kDx;
-using test::kVp;
-using test::make_cell;
-using test::random_points;
+using namespace mrf::test;  // the fluid cell and particles of support/coupling_cell.hpp
 
 // The Shepard sums, their rate and the buoyancy run on threads by blocks of
 // whole DEM runs of the pairs (each DEM particle's sums in one block, in
