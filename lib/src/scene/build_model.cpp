@@ -24,10 +24,12 @@ namespace {
 // but no more than 0.5 (chains lower eps locally during a run; at phi = 0.3
 // and a kernel of >= 2d the SPH-scale porosity stays above it).
 constexpr double k_design_porosity = 0.5;
-// Verlet skin of the SPH pairs of the coupled schemes, / h: it changes no
-// result (the pairs come sorted, as a fresh search's would be); an SPH
-// particle's non-affine motion is a small fraction of h per step, so the
-// list lasts tens of steps.
+// Verlet skin of the SPH pairs of the coupled schemes, / h. The pairs come
+// sorted by (a, b, image) whenever the candidates were built, so the result
+// does not depend on the rebuilds (a fresh search every step, as the inertial
+// scheme did before session 25, orders them by cell: the sums round
+// differently). An SPH particle's non-affine motion is a small fraction of h
+// per step, so the list lasts tens of steps.
 constexpr double k_sph_skin_over_h = 0.2;
 // Verlet skin of the DEM-SPH coupling pairs, / h. It changes no result (the
 // pairs equal a fresh search's); it trades the candidates' sweep,
