@@ -455,8 +455,9 @@ def low_mn(argv, here, crit, phi, aqs_quote):
     bad = [r["seed"] for r in rows if not steady(r)]
     pfail = [r["seed"] for r in rows if particle_rule(r) not in ("ok", "untested")]
     lines += ["| Mn | seeds | particle part | note |", "|---:|---:|---:|---|",
-              f"| 3e-4 | {n} | {mean:.4f} ± {fe(err)} | seed scatter / within-run "
-              f"{(scatter / within if within > 0 else float('nan')):.2f}"
+              f"| 3e-4 | {n} | {mean:.4f} ± {fe(err)} | "
+              + (f"seed scatter / within-run {scatter / within:.2f}" if n > 1 and within > 0 else
+                 "one seed: within-run error only, which the seed scatter can exceed several times")
               + (f"; not steady: seeds {', '.join(bad)}" if bad else "")
               + (f"; particle-part rule not passed: seeds {', '.join(pfail)}" if pfail else "")
               + ("; runs without the version-2 estimate (the rule untested)"
