@@ -360,7 +360,9 @@ def answers(crit, small, phi, small_m, pstate, unsteady, claim_lines, cost_line,
                          "lowest Mn is " + "; ".join(f"{c[0]} s = {c[4]}, {'flat' if c[6] == 'yes' else 'not flat'}"
                                                      for c in flat))
         lines.append("")
-    lines += [x for x in extra if x] + [cost_line, ""]
+    for x in extra:
+        lines += [x, ""]
+    lines += [cost_line, ""]
     return lines
 
 
