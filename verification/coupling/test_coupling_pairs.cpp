@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "mrf/coupling/exchange.hpp"
@@ -21,6 +22,20 @@ namespace mrf {
 namespace {
 
 using namespace mrf::test;  // the fluid cell and particles of support/coupling_cell.hpp
+
+// Two pair lists and their kernel gradients equal entry for entry, bit for bit.
+void same_pairs_bit_for_bit(const std::vector<CouplingPair>& a, const std::vector<Vec3>& a_dw,
+                            const std::vector<CouplingPair>& b, const std::vector<Vec3>& b_dw) {
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_EQ(a_dw.size(), a.size());
+  ASSERT_EQ(b_dw.size(), b.size());
+  for (std::size_t k = 0; k < b.size(); ++k) {
+    ASSERT_EQ(a[k].i, b[k].i) << "entry " << k;
+    ASSERT_EQ(a[k].a, b[k].a) << "entry " << k;
+    ASSERT_EQ(a[k].w, b[k].w) << "entry " << k;
+    ASSERT_EQ(a_dw[k], b_dw[k]) << "entry " << k;
+  }
+}
 
 TEST(CouplingExchange, PairsMatchBruteForce) {
   const FluidCell c = make_cell();
@@ -94,14 +109,8 @@ TEST(CouplingExchange, PairsAreTheSameOnAnyNumberOfThreads) {
   for (int t : {2, 3}) {
     omp_set_num_threads(t);
     coupling_pairs(dem, c.fluid.x, c.box, c.h, many, &many_dw);
-    ASSERT_EQ(many.size(), one.size()) << t << " threads";
-    ASSERT_EQ(many_dw.size(), one.size()) << t << " threads";
-    for (std::size_t k = 0; k < one.size(); ++k) {
-      ASSERT_EQ(many[k].i, one[k].i) << k;
-      ASSERT_EQ(many[k].a, one[k].a) << k;
-      ASSERT_EQ(many[k].w, one[k].w) << k;
-      ASSERT_EQ(many_dw[k], one_dw[k]) << k;
-    }
+    SCOPED_TRACE(std::to_string(t) + " threads");
+    ASSERT_NO_FATAL_FAILURE(same_pairs_bit_for_bit(many, many_dw, one, one_dw));
   }
   omp_set_num_threads(saved);
   EXPECT_TRUE(std::is_sorted(one.begin(), one.end(), [](const CouplingPair& x, const CouplingPair& y) {
@@ -156,13 +165,8 @@ TEST(CouplingExchange, CachedPairsEqualAFreshSearchAtEveryStep) {
       if (coupling_cache_stale(cache, dem, sph, box, c.h)) rebuild_coupling_cache(cache, dem, sph, box, c.h);
       coupling_pairs_of(cache.candidates, dem, sph, box, c.h, cached, &cached_dw);
       coupling_pairs(dem, sph, box, c.h, fresh, &fresh_dw);
-      ASSERT_EQ(cached.size(), fresh.size()) << "step " << step;
-      for (std::size_t k = 0; k < fresh.size(); ++k) {
-        ASSERT_EQ(cached[k].i, fresh[k].i) << k;
-        ASSERT_EQ(cached[k].a, fresh[k].a) << k;
-        ASSERT_EQ(cached[k].w, fresh[k].w) << k;
-        ASSERT_EQ(cached_dw[k], fresh_dw[k]) << k;
-      }
+      SCOPED_TRACE("step " + std::to_string(step));
+      ASSERT_NO_FATAL_FAILURE(same_pairs_bit_for_bit(cached, cached_dw, fresh, fresh_dw));
       move(dem);
       move(sph);
       cache.strain += d_strain;
