@@ -14,7 +14,12 @@ way (a point whose re-run is pending reads as its first run there too), and
 so is the convergence table (reports/study/paper/convergence.md) from
 reports/study/paper/convergence/points.
 
-usage: scripts/paper_interim.py [--mrf build/mrf] [--note TEXT]
+With --runs the four sweeps are read from their run folders
+(out/sweeps/<sweep name>, laid out as an archive is) instead of the
+committed archives: what `scripts/reproduce paper` does after running them
+from scratch.
+
+usage: scripts/paper_interim.py [--mrf build/mrf] [--note TEXT] [--runs]
 """
 import json
 import os
@@ -99,32 +104,39 @@ def main():
     mrf = arg("--mrf", "build/mrf")
     paper = "reports/study/paper"
     sweeps = "experiments/sweeps"
+    # where each sweep's finished points are read from
+    if "--runs" in sys.argv:
+        src = {n: os.path.join("out", "sweeps", n) for n in
+               ("paper_realistic", "paper_fixed_m", "paper_low_mn", "paper_convergence")}
+    else:
+        src = {"paper_realistic": f"{paper}/points", "paper_fixed_m": f"{paper}/fixed_m_points",
+               "paper_low_mn": f"{paper}/low_mn_points", "paper_convergence": f"{paper}/convergence/points"}
     tmp = os.path.join(sweeps, "_paper_interim.toml")  # beside the others: the scene path is relative
     try:
         for name, archive, csv_name, crit_name in (
-                ("paper_realistic", f"{paper}/points", "sweep.csv", "criterion.json"),
-                ("paper_fixed_m", f"{paper}/fixed_m_points", "fixed_m_sweep.csv", "fixed_m_criterion.json")):
+                ("paper_realistic", src["paper_realistic"], "sweep.csv", "criterion.json"),
+                ("paper_fixed_m", src["paper_fixed_m"], "fixed_m_sweep.csv", "fixed_m_criterion.json")):
             pending = interim_toml(os.path.join(sweeps, name + ".toml"), archive, tmp)
             print(f"{name}: re-runs pending: {', '.join(pending) if pending else 'none'}")
             out = os.path.join("out", "sweeps", name + "_interim")
             collect(mrf, tmp, out, archive)
             shutil.copy(os.path.join(out, "sweep.csv"), os.path.join(paper, csv_name))
             shutil.copy(os.path.join(out, "criterion.json"), os.path.join(paper, crit_name))
-        n = reanalysed(mrf, f"{paper}/points", os.path.join(paper, "reanalysed.json"))
+        n = reanalysed(mrf, src["paper_realistic"], os.path.join(paper, "reanalysed.json"))
         print(f"paper_realistic: {n} archived runs re-analysed from their window series")
         # model 1 below Mn 1e-3 (no re-run rules: collected as it stands)
-        if os.path.isdir(f"{paper}/low_mn_points"):
+        if os.path.isdir(src["paper_low_mn"]):
             out = os.path.join("out", "sweeps", "paper_low_mn_interim")
             shutil.rmtree(out, ignore_errors=True)
             subprocess.run([mrf, "sweep", os.path.join(sweeps, "paper_low_mn.toml"), "--out", out, "--archive",
-                            f"{paper}/low_mn_points", "--collect", "--quiet"], check=True)
+                            src["paper_low_mn"], "--collect", "--quiet"], check=True)
             shutil.copy(os.path.join(out, "sweep.csv"), os.path.join(paper, "low_mn_sweep.csv"))
         # the convergence variants against the realistic path's seed means
-        pending = interim_toml(os.path.join(sweeps, "paper_convergence.toml"), f"{paper}/convergence/points", tmp)
+        pending = interim_toml(os.path.join(sweeps, "paper_convergence.toml"), src["paper_convergence"], tmp)
         print(f"paper_convergence: re-runs pending: {', '.join(pending) if pending else 'none'}")
         out = os.path.join("out", "sweeps", "paper_convergence_interim")
         shutil.rmtree(out, ignore_errors=True)
-        subprocess.run([mrf, "sweep", tmp, "--out", out, "--archive", f"{paper}/convergence/points", "--collect",
+        subprocess.run([mrf, "sweep", tmp, "--out", out, "--archive", src["paper_convergence"], "--collect",
                         "--quiet"], check=True)
         subprocess.run(["/usr/bin/python3", "reports/paper_convergence.py", os.path.join(out, "sweep.csv"),
                         os.path.join(paper, "sweep.csv"), os.path.join(paper, "convergence.md")], check=True)

@@ -125,14 +125,28 @@ int sweep_command(const SweepArgs& a) {
   if (a.estimate) {
     const auto points = mrf::sweep_points(spec);
     const mrf::PointEstimates est = mrf::estimate_points(spec, points, out, opt.cost_rate, a.archive, a.calibrate);
-    double total = 0;
-    std::size_t model_only = 0;
+    double total = 0, left = 0;
+    std::size_t model_only = 0, to_run = 0;
     for (const auto& p : points) {
       const double e = est.seconds[p.index];
-      std::printf("%-40s estimated %.3g s%s\n", p.dir.c_str(), e, est.calibrated[p.index] ? "" : " *");
+      // finished: a summary of this scene in --out, or an archive entry of it
+      auto finished_in = [&](const std::string& root) {
+        const std::filesystem::path dir = std::filesystem::path(root) / p.dir;
+        return !root.empty() && std::filesystem::exists(dir / "summary.json") && !mrf::point_stale(spec, p, dir);
+      };
+      const bool finished = finished_in(out) || finished_in(a.archive);
+      std::printf("%-40s estimated %.3g s%s%s\n", p.dir.c_str(), e, est.calibrated[p.index] ? "" : " *",
+                  finished ? " (finished)" : "");
       if (e == e) total += e;
+      if (!finished) {
+        ++to_run;
+        if (e == e) left += e;
+      }
       model_only += est.calibrated[p.index] ? 0 : 1;
     }
+    // the last two lines: what is left to run, then the whole sweep
+    std::printf("to run %.3g s (%.3g h) on one core: %zu of %zu points (the others finished in %s%s)\n", left,
+                left / 3600, to_run, points.size(), out.c_str(), a.archive.empty() ? "" : (" or " + a.archive).c_str());
     std::printf("total %.3g s (%.3g h) on one core; %zu points (*) from the particle-steps model at %.3g "
                 "particle-steps/s (blind to the implicit schemes' error-controlled steps: a lower bound), the rest "
                 "from the finished points in %s%s%s\n",

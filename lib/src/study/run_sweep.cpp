@@ -99,9 +99,12 @@ PointEstimates estimate_points(const SweepSpec& spec, const std::vector<SweepPoi
     // archive (a --point run restores no other point, and an archived entry
     // of an edited scene is re-run) or in the calibration folder calibrates
     // by its seconds per strain unit.
+    // A stale one (a run for another scene, e.g. before a rule changed its
+    // strain) calibrates by its seconds per strain unit, as an archived one.
     auto path = std::filesystem::path(out_dir) / points[k].dir / "summary.json";
-    const bool own = std::filesystem::exists(path);
-    if (!own) {
+    const bool present = std::filesystem::exists(path);
+    const bool own = present && !point_stale(spec, points[k], path.parent_path());
+    if (!present) {
       // the calibration folder may be a sweep without this sweep's
       // variants: the same model, Mn and seed there calibrate too
       std::string plain = points[k].dir;
@@ -132,11 +135,15 @@ PointEstimates estimate_points(const SweepSpec& spec, const std::vector<SweepPoi
       e.calibrated[k] = 1;
       continue;
     }
-    const Measured* near = nullptr;
-    for (const Measured& m : done)
+    // its own earlier run (stale, archived or in the calibration folder)
+    // first, else the nearest Mn of the model
+    const Measured* near = done[k].per_strain > 0 ? &done[k] : nullptr;
+    for (const Measured& m : done) {
+      if (done[k].per_strain > 0) break;
       if (m.per_strain > 0 && m.model == points[k].model &&
           (!near || std::abs(m.log_mn - std::log(points[k].mason)) < std::abs(near->log_mn - std::log(points[k].mason))))
         near = &m;
+    }
     if (near) {
       try {
         e.seconds[k] = near->per_strain * load_scene(spec.scene_path, points[k].sets).config.strain;

@@ -1,0 +1,83 @@
+#!/usr/bin/env python3
+"""ctest SweepEstimate: `mrf sweep --estimate` on a 2-point sweep of model 1
+(Mn 0.3 and 1, strain 0.2), what `scripts/reproduce paper --estimate` reads.
+
+- Before anything ran: 2 of 2 points to run, and the "to run" seconds are
+  the total's.
+- After point 0 ran: its line says (finished) with its own wall seconds as
+  the estimate; 1 of 2 points to run, and the "to run" seconds are point
+  1's estimate alone.
+- The same from the archive alone (the output folder removed).
+- After a rule doubles point 0's strain (its run is now for another scene):
+  2 of 2 to run, and point 0 is estimated by its own earlier run's seconds
+  per strain unit times the new strain (not by its old wall time).
+
+Usage: sweep_estimate_check.py MRF_BINARY SCENE WORKDIR
+"""
+import json, pathlib, re, shutil, subprocess, sys
+
+mrf, scene, work = sys.argv[1], sys.argv[2], pathlib.Path(sys.argv[3])
+shutil.rmtree(work, ignore_errors=True)
+work.mkdir(parents=True)
+HEAD = f"""[sweep]
+scene = "{scene}"
+models = ["dem_stokes"]
+mason = [0.3, 1.0]
+seeds = [1]
+set = ["drive.strain=0.2", "drive.warmup_strain=0.05", "numerics.threads=1"]
+"""
+sweep = work / "tiny.toml"
+sweep.write_text(HEAD)
+out, archive = work / "out", work / "archive"
+
+
+def estimate(*extra):
+    text = subprocess.run([mrf, "sweep", str(sweep), "--out", str(out), "--estimate", *extra], check=True,
+                          capture_output=True, text=True).stdout
+    lines = text.strip().splitlines()
+    per = {}
+    for ln in lines[:-2]:
+        m = re.match(r"(\S+)\s+estimated (\S+) s", ln)
+        per[m.group(1)] = (float(m.group(2)), "(finished)" in ln)
+    run = re.match(r"to run (\S+) s \(\S+ h\) on one core: (\d+) of (\d+) points", lines[-2])
+    tot = re.match(r"total (\S+) s", lines[-1])
+    assert run and tot, f"unexpected estimate output:\n{text}"
+    return per, float(run.group(1)), int(run.group(2)), int(run.group(3)), float(tot.group(1))
+
+
+def close(a, b):
+    return abs(a - b) <= 1e-2 * max(abs(a), abs(b))
+
+
+p0, p1 = "dem_stokes/mn_0.3_seed_1", "dem_stokes/mn_1_seed_1"
+per, left, n_run, n, total = estimate()
+assert (n_run, n) == (2, 2) and close(left, total), (n_run, n, left, total)
+assert not per[p0][1] and not per[p1][1]
+print(f"nothing run: 2 of 2 to run, {left:.3g} s = the total")
+
+subprocess.run([mrf, "sweep", str(sweep), "--out", str(out), "--archive", str(archive), "--point", "0", "--quiet"],
+               check=True, capture_output=True)
+s0 = json.loads((out / p0 / "summary.json").read_text())
+for extra in ((), ("--archive", str(archive))):
+    if extra:
+        shutil.rmtree(out)
+    per, left, n_run, n, total = estimate(*extra)
+    assert per[p0][1] and not per[p1][1], per
+    assert (n_run, n) == (1, 2), (n_run, n)
+    assert close(left, per[p1][0]), (left, per[p1][0])
+    if not extra:  # a point finished in --out is its own estimate
+        assert close(per[p0][0], s0["wall_seconds"]), (per[p0][0], s0["wall_seconds"])
+    print(f"point 0 finished ({'archive' if extra else 'output'}): 1 of 2 to run, {left:.3g} s = point 1's estimate")
+
+# point 0 run again into --out, then a rule doubles its strain: stale
+subprocess.run([mrf, "sweep", str(sweep), "--out", str(out), "--point", "0", "--quiet"], check=True,
+               capture_output=True)
+s0 = json.loads((out / p0 / "summary.json").read_text())
+sweep.write_text(HEAD + '\n[[rule]]\nmason_max = 0.5\nset = ["drive.strain=0.4", "drive.warmup_strain=0.1"]\n')
+per, left, n_run, n, total = estimate()
+assert (n_run, n) == (2, 2), (n_run, n)
+assert not per[p0][1], "a run for another scene does not count as finished"
+want = s0["seconds_per_strain"] * 0.4
+assert close(per[p0][0], want), f"stale point 0 estimated {per[p0][0]} s, want its own {s0['seconds_per_strain']} s per strain x 0.4"
+print(f"rule changed point 0's strain: 2 of 2 to run, point 0 at its own rate x new strain ({per[p0][0]:.3g} s)")
+print("SweepEstimate: ok")
