@@ -10,6 +10,7 @@
 
 #include "mrf/error.hpp"
 #include "mrf/scene/run.hpp"
+#include "mrf/scene/run_series.hpp"
 
 namespace mrf {
 namespace {
@@ -80,7 +81,32 @@ TEST(Checkpoint, RefusesACheckpointOfAnotherScene) {
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
     EXPECT_EQ(e.key(), "--resume") << e.what();
+    // it names what differs, with both values (M is fixed: Mn moves the shear rate too)
+    EXPECT_NE(std::string(e.what()).find("drive.mason 1 in the checkpoint, 0.9 now"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("drive.shear_rate"), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find("drive.strain"), std::string::npos) << e.what();
   }
+}
+
+// The difference of two fingerprints names each key that differs, and a key
+// that entered the fingerprint later (numerics.newton_tol: only a value
+// other than its default) against the default it had before.
+TEST(Checkpoint, FingerprintDifferenceNamesTheKeysThatDiffer) {
+  const SceneConfig a = scene("implicit").config;
+  SceneConfig b = a;
+  EXPECT_EQ(fingerprint_difference(scene_fingerprint(a), scene_fingerprint(b)), "");
+  b.seed = 7;
+  b.strain = 2.5;
+  EXPECT_EQ(fingerprint_difference(scene_fingerprint(a), scene_fingerprint(b)),
+            "drive.strain 0.5 in the checkpoint, 2.5 now; scene.seed 1 in the checkpoint, 7 now");
+  b = a;
+  b.newton_tol = 1e-5;
+  EXPECT_EQ(fingerprint_difference(scene_fingerprint(a), scene_fingerprint(b)),
+            "numerics.newton_tol 1e-06 (default) in the checkpoint, 1e-05 now");
+  b = a;
+  b.model = ModelId::demsph_dd;
+  EXPECT_EQ(fingerprint_difference(scene_fingerprint(a), scene_fingerprint(b)),
+            "scene.model dem_stokes in the checkpoint, demsph_dd now");
 }
 
 // Coupled DEM-SPH runs (models 2 and 3) on the small scene at Mn 1: strain

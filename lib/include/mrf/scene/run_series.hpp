@@ -128,6 +128,9 @@ struct LoopState {
 
 // Every parameter of the scene, exactly: a checkpoint resumes only into the same run.
 std::string scene_fingerprint(const SceneConfig& c);
+// Which scene keys two fingerprints disagree on, with both values ("drive.strain
+// 24 in the checkpoint, 12 now; ..."): what a refused resume names.
+std::string fingerprint_difference(const std::string& was, const std::string& now);
 // Its CRC-32 as 8 hex digits: summary.json's scene_id, by which a sweep
 // archive tells a result of this scene from one of an edited scene.
 std::string scene_id(const SceneConfig& c);
