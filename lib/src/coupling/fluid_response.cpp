@@ -99,21 +99,17 @@ double FluidResponse::coupling(std::size_t i, std::size_t k) const {
 
 namespace {
 // The two gathers of FluidResponse::add on xyz padded to four doubles, so
-// that one entry is one offset (4 x index), one weight and one four-wide
-// load, multiply and add: with a 64-bit running position and the offsets
-// stored ready, about five instructions an entry (seven when the loop
-// recomputed e + k in 32 bits and shifted each index): 333 -> 295 us per
-// product in bench_fluid_response. Not the bytes read: single-precision
-// weights (a third less per entry) took 306 us. Four partial sums per row
-// (entries e, e+1, e+2, e+3 mod 4), added pairwise at the end: one sum
-// alone is a chain of dependent adds, which held the loop to one entry per
-// add latency (perf: 90 % of its samples on the add). The order is fixed by the pairs alone, so the
-// result does not depend on the thread count. Cloned for AVX2 and the
-// baseline, chosen when the program loads; neither clone has FMA, so a
-// product and its add stay two roundings on both (GCC would fuse them where
-// FMA is enabled: its C++ default is -ffp-contract=fast). An AVX-512 clone,
-// and a Highway version with two entries per 512-bit register, were slower
-// (bench_fluid_response 359 -> 364 and 378 us, session 25).
+// that one entry is one offset (4 x index, stored ready, read with a 64-bit
+// running position), one weight and one four-wide load, multiply and add.
+// Four partial sums per row (entries e, e+1, e+2, e+3 mod 4), added pairwise
+// at the end: one sum alone is a chain of dependent adds, one entry per add
+// latency. The order is fixed by the pairs alone, so the result does not
+// depend on the thread count. Cloned for AVX2 and the baseline, chosen when
+// the program loads; neither clone has FMA, so a product and its add stay
+// two roundings on both (GCC would fuse them where FMA is enabled: its C++
+// default is -ffp-contract=fast). What each choice measured, and the
+// variants that were slower (float weights, an AVX-512 clone, Highway):
+// docs/performance.md, "The fluid response's gathers".
 __attribute__((target_clones("avx2", "default"))) void gather4(std::size_t rows, const std::uint32_t* row_of,
                                                                  const std::uint32_t* start, const std::uint32_t* col,
                                                                  const double* w, const double* in, double* out,

@@ -16,19 +16,14 @@
 //
 // The loop is bound by latency, not by arithmetic: each vector's chain runs
 // from the index loads through the wrap, r^2, a square root and a division
-// (about 20 and 13 cycles on Zen 2) to the laws and the stores, and its uops
-// that wait for 1/r fill the scheduler. So (measured on Zen 2, AVX2, side by
-// side in Google Benchmark, PaperPairForces, session 17): 1/r is
-// sqrt(r^2) * (1 / r^2), the two divider operations in parallel (1.08x
-// against 1 / sqrt); one mask on 1/r instead of one per force component
-// (1.10x); the wrap rounds with one instruction (1.04x); and the loop is
-// software-pipelined by one vector, the geometry and 1/r of the next
-// vector issued before the laws of this one (1.40x); a row's last vector
-// padded with the dummy instead of a scalar tail (1.03x). Not kept: a
-// single-precision rsqrt refined by two steps (0.7-0.85x: the conversions
-// and the refinement lengthen the chain), pipelining by two vectors (0.9x:
-// registers spill), one pipeline across rows (0.78x: the row of each
-// vector and its partners carried along).
+// to the laws and the stores. So 1/r is sqrt(r^2) * (1 / r^2) (the two
+// divider operations in parallel), one mask on 1/r serves every force
+// component, the wrap rounds with one instruction, the loop is
+// software-pipelined by one vector (the geometry and 1/r of the next vector
+// issued before the laws of this one), and a row's last vector is padded
+// with the dummy instead of a scalar tail. The gain of each, and what was
+// tried and not kept: docs/performance.md, "Pair-kernel floating-point rate"
+// (session 17's table).
 //
 // The pair forces are the scalar loop's expressions except 1/r (a few ulp
 // from 1/sqrt), and the row sums run in another order, so forces and sums
