@@ -97,10 +97,9 @@ PointEstimates estimate_points(const SweepSpec& spec, const std::vector<SweepPoi
   for (std::size_t k = 0; k < points.size(); ++k) {
     // A point finished under out_dir is its own estimate; one only in the
     // archive (a --point run restores no other point, and an archived entry
-    // of an edited scene is re-run) or in the calibration folder calibrates
-    // by its seconds per strain unit.
-    // A stale one (a run for another scene, e.g. before a rule changed its
-    // strain) calibrates by its seconds per strain unit, as an archived one.
+    // of an edited scene is re-run) or in the calibration folder, or a
+    // stale one under out_dir (a run for another scene, e.g. before a rule
+    // changed its strain), calibrates by its seconds per strain unit.
     auto path = std::filesystem::path(out_dir) / points[k].dir / "summary.json";
     const bool present = std::filesystem::exists(path);
     const bool own = present && !point_stale(spec, points[k], path.parent_path());
