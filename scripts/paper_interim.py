@@ -123,7 +123,8 @@ def main():
             shutil.copy(os.path.join(out, "sweep.csv"), os.path.join(paper, csv_name))
             shutil.copy(os.path.join(out, "criterion.json"), os.path.join(paper, crit_name))
         n = reanalysed(mrf, src["paper_realistic"], os.path.join(paper, "reanalysed.json"))
-        print(f"paper_realistic: {n} archived runs re-analysed from their window series")
+        print(f"paper_realistic: {n} runs re-analysed from their window series (runs that carry the version-2 "
+              "estimate need none; a run folder keeps no window series)")
         # model 1 below Mn 1e-3 (no re-run rules: collected as it stands)
         if os.path.isdir(src["paper_low_mn"]):
             out = os.path.join("out", "sweeps", "paper_low_mn_interim")

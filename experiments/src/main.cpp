@@ -25,6 +25,12 @@
 
 namespace {
 
+std::string join(const std::vector<std::string>& v) {
+  std::string out;
+  for (const std::string& s : v) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+
 int run_command(const std::string& scene_path, const std::vector<std::string>& sets, std::string out, bool quiet,
                 bool resume, double checkpoint_seconds) {
   const mrf::LoadedScene scene = mrf::load_scene(scene_path, sets);
@@ -64,7 +70,8 @@ namespace {
 #endif
 
 struct SweepArgs {
-  std::string file, out, archive, calibrate;
+  std::string file, out, archive;
+  std::vector<std::string> calibrate;
   bool quiet = false, estimate = false, list = false, collect = false, no_csv = false;
   int rank = 0, ranks = 0;
   long point = -1;
@@ -91,10 +98,14 @@ int sweep_command(const SweepArgs& a) {
   opt.checkpoint_seconds = a.checkpoint_seconds;
   opt.archive = a.archive;
   opt.calibrate = a.calibrate;
-  if (!a.calibrate.empty() && !std::filesystem::is_directory(a.calibrate))
-    throw mrf::InputError("--calibrate-from", a.calibrate, "", "is not a folder (of finished points' summary.json)");
+  for (const std::string& d : a.calibrate)
+    if (!std::filesystem::is_directory(d))
+      throw mrf::InputError("--calibrate-from", d, "", "is not a folder (of finished points' summary.json)");
   opt.write_csv = !a.no_csv;
-  if (!a.archive.empty() && (a.collect || a.list || a.estimate))  // a run restores its own share (run_sweep)
+  // --collect and --list read --out, so they restore the archive into it
+  // first (a run restores its own share, run_sweep); --estimate writes
+  // nothing and reads the archive where it is
+  if (!a.archive.empty() && (a.collect || a.list))
     mrf::report_archive(mrf::restore_from_archive(spec, mrf::sweep_points(spec), out, a.archive), a.archive, a.quiet);
   if (a.collect) {  // sweep.csv from the finished points, nothing run (while other ranks still work)
     const auto points = mrf::sweep_points(spec);
@@ -129,30 +140,33 @@ int sweep_command(const SweepArgs& a) {
     std::size_t model_only = 0, to_run = 0;
     for (const auto& p : points) {
       const double e = est.seconds[p.index];
-      // finished: a summary of this scene in --out, or an archive entry of it
-      auto finished_in = [&](const std::string& root) {
+      // done: a summary of this scene in --out or the archive (finished), or
+      // a failure.json in --out (failed: a sweep does not run it again)
+      auto has = [&](const std::string& root, const char* file) {
         const std::filesystem::path dir = std::filesystem::path(root) / p.dir;
-        return !root.empty() && std::filesystem::exists(dir / "summary.json") && !mrf::point_stale(spec, p, dir);
+        return !root.empty() && std::filesystem::exists(dir / file) && !mrf::point_stale(spec, p, dir);
       };
-      const bool finished = finished_in(out) || finished_in(a.archive);
+      const bool finished = has(out, "summary.json") || has(a.archive, "summary.json");
+      const bool failed = !finished && has(out, "failure.json");
       std::printf("%-40s estimated %.3g s%s%s\n", p.dir.c_str(), e, est.calibrated[p.index] ? "" : " *",
-                  finished ? " (finished)" : "");
+                  finished ? " (finished)" : failed ? " (failed)" : "");
       if (e == e) total += e;
-      if (!finished) {
+      if (!finished && !failed) {
         ++to_run;
         if (e == e) left += e;
       }
       model_only += est.calibrated[p.index] ? 0 : 1;
     }
     // the last two lines: what is left to run, then the whole sweep
-    std::printf("to run %.3g s (%.3g h) on one core: %zu of %zu points (the others finished in %s%s)\n", left,
-                left / 3600, to_run, points.size(), out.c_str(), a.archive.empty() ? "" : (" or " + a.archive).c_str());
+    std::printf("to run %.3g s (%.3g h) on one core: %zu of %zu points (%zu finished or failed in %s%s)\n", left,
+                left / 3600, to_run, points.size(), points.size() - to_run, out.c_str(),
+                a.archive.empty() ? "" : (" or " + a.archive).c_str());
     std::printf("total %.3g s (%.3g h) on one core; %zu points (*) from the particle-steps model at %.3g "
                 "particle-steps/s (blind to the implicit schemes' error-controlled steps: a lower bound), the rest "
                 "from the finished points in %s%s%s\n",
                 total, total / 3600, model_only, opt.cost_rate, out.c_str(),
                 a.archive.empty() ? "" : (" and " + a.archive).c_str(),
-                a.calibrate.empty() ? "" : (" and, for the cost alone, " + a.calibrate).c_str());
+                a.calibrate.empty() ? "" : (" and, for the cost alone, " + join(a.calibrate)).c_str());
     return 0;
   }
 #ifdef MRF_HAVE_MPI
@@ -213,7 +227,8 @@ int main(int argc, char** argv) {
                  "finish; an entry of an edited scene is ignored");
   sw->add_option("--calibrate-from", sa.calibrate,
                  "folder laid out like an archive whose summaries calibrate the cost estimates only (nothing is "
-                 "restored from it): an estimate for a fresh run from the measured cost of an earlier one");
+                 "restored from it): an estimate for a fresh run from the measured cost of an earlier one; "
+                 "repeatable, the first folder that has a point calibrates it");
   sw->add_flag("--no-csv", sa.no_csv, "do not rewrite sweep.csv at the end (concurrent --point runs: --collect once)");
   sw->add_option("--point", sa.point, "run point K of the grid alone (0-based, as --list numbers them)");
   sw->add_option("--checkpoint-every", sa.checkpoint_seconds, "wall seconds between a point's checkpoints (0 = none)")

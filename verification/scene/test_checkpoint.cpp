@@ -3,6 +3,7 @@
 // coupled DEM-SPH runs; a checkpoint never resumes into a different scene.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -107,6 +108,20 @@ TEST(Checkpoint, FingerprintDifferenceNamesTheKeysThatDiffer) {
   b.model = ModelId::demsph_dd;
   EXPECT_EQ(fingerprint_difference(scene_fingerprint(a), scene_fingerprint(b)),
             "scene.model dem_stokes in the checkpoint, demsph_dd now");
+  // values apart beyond ten digits are shown with seventeen; dt unset is "auto"
+  b = a;
+  b.shear_rate = std::nextafter(a.shear_rate, 2 * a.shear_rate);
+  b.dt = 1e-7;
+  const std::string d = fingerprint_difference(scene_fingerprint(a), scene_fingerprint(b));
+  EXPECT_NE(d.find("numerics.dt auto in the checkpoint, 1e-07 now"), std::string::npos) << d;
+  EXPECT_NE(d.find("drive.shear_rate "), std::string::npos) << d;
+  const std::size_t at = d.find("drive.shear_rate ");
+  const std::string sr = d.substr(at, d.find(';', at) - at);
+  EXPECT_GE(sr.size(), std::string("drive.shear_rate  in the checkpoint,  now").size() + 2 * 17) << sr;
+  // a fingerprint of another layout (fewer fields) is named as such, not read by position
+  std::string old = scene_fingerprint(a);
+  old.erase(old.rfind(';'));
+  EXPECT_NE(fingerprint_difference(old, scene_fingerprint(a)).find("another version of mrf"), std::string::npos);
 }
 
 // Coupled DEM-SPH runs (models 2 and 3) on the small scene at Mn 1: strain

@@ -7,7 +7,8 @@
 - After point 0 ran: its line says (finished) with its own wall seconds as
   the estimate; 1 of 2 points to run, and the "to run" seconds are point
   1's estimate alone.
-- The same from the archive alone (the output folder removed).
+- The same from the archive alone (the output folder removed), which the
+  estimate reads where it is: it writes nothing into --out.
 - After a rule doubles point 0's strain (its run is now for another scene):
   2 of 2 to run, and point 0 is estimated by its own earlier run's seconds
   per strain unit times the new strain (not by its old wall time).
@@ -67,6 +68,8 @@ for extra in ((), ("--archive", str(archive))):
     assert close(left, per[p1][0]), (left, per[p1][0])
     if not extra:  # a point finished in --out is its own estimate
         assert close(per[p0][0], s0["wall_seconds"]), (per[p0][0], s0["wall_seconds"])
+    else:  # read where it is: an estimate writes nothing into --out
+        assert not out.exists(), "--estimate --archive restored the archive into --out"
     print(f"point 0 finished ({'archive' if extra else 'output'}): 1 of 2 to run, {left:.3g} s = point 1's estimate")
 
 # point 0 run again into --out, then a rule doubles its strain: stale

@@ -187,17 +187,22 @@ TEST(Sweep, KilledSweepResumesAndReproduces) {
   // estimated from an earlier one's measured cost) gives the same estimates;
   // the archive, where it has the point, comes first.
   const PointEstimates calibrated =
-      estimate_points(wider, pts, (out / "nothing_here").string(), 1e6, "", out.string());
+      estimate_points(wider, pts, (out / "nothing_here").string(), 1e6, "", {out.string()});
   EXPECT_TRUE(calibrated.calibrated[1] && calibrated.calibrated[2]);
   EXPECT_DOUBLE_EQ(calibrated.seconds[1], archived.seconds[1]);
   EXPECT_DOUBLE_EQ(calibrated.seconds[2], archived.seconds[2]);
   const PointEstimates both =
-      estimate_points(wider, pts, (out / "nothing_here").string(), 1e6, out.string(), (out / "nothing_here").string());
+      estimate_points(wider, pts, (out / "nothing_here").string(), 1e6, out.string(), {(out / "nothing_here").string()});
   EXPECT_DOUBLE_EQ(both.seconds[1], archived.seconds[1]);
+  // --calibrate-from given twice: a folder without the point is passed over
+  const PointEstimates two_folders = estimate_points(wider, pts, (out / "nothing_here").string(), 1e6, "",
+                                                     {(out / "nothing_here").string(), out.string()});
+  EXPECT_TRUE(two_folders.calibrated[1]);
+  EXPECT_DOUBLE_EQ(two_folders.seconds[1], archived.seconds[1]);
   // A sweep with --calibrate-from runs its points: nothing is restored from
   // the calibration folder; its seconds per strain unit give the estimate.
   SweepOptions cal = opt;
-  cal.calibrate = out.string();
+  cal.calibrate = {out.string()};
   const auto fresh_out = std::filesystem::temp_directory_path() / "mrf_test_sweep_calibrated";
   std::filesystem::remove_all(fresh_out);
   // a variant sweep calibrated by a plain one: the same model, Mn and seed
@@ -207,7 +212,7 @@ TEST(Sweep, KilledSweepResumesAndReproduces) {
       "set = [\"contact.youngs_modulus=4e10\"]\n",
       "tiny.toml", k_scenes);
   const PointEstimates by_plain = estimate_points(with_variant, sweep_points(with_variant),
-                                                  (out / "nothing_here").string(), 1e6, "", out.string());
+                                                  (out / "nothing_here").string(), 1e6, "", {out.string()});
   ASSERT_TRUE(by_plain.calibrated[0]);
   EXPECT_DOUBLE_EQ(by_plain.seconds[0], read_json(p1 / "summary.json")["seconds_per_strain"].get<double>() * 0.6);
   const SweepSpec short_one = parse_sweep(

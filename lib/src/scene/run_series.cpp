@@ -10,7 +10,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <iterator>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -18,7 +17,6 @@
 
 #include "mrf/error.hpp"
 #include "mrf/io/atomic_file.hpp"
-#include "mrf/io/checksum.hpp"
 #include "mrf/observe/block_average.hpp"
 #include "mrf/observe/steady_state.hpp"
 #include "mrf/observe/stress.hpp"
@@ -222,89 +220,6 @@ long series_every(const LoadedScene& scene, long steps) {
   throw InputError("drive.strain", num(c.strain), scene.locate("drive.strain"), why);
 }
 
-namespace {
-// The scene keys a fingerprint holds, in its order (the order is part of
-// every archived scene_id: append, never reorder).
-constexpr const char* k_fingerprint_keys[] = {
-    "box.gap", "box.ly", "box.lz", "particles.radius", "particles.volume_fraction", "particles.density",
-    "particles.magnetization", "particles.dipole_cutoff", "walls.spacing", "contact.youngs_modulus",
-    "contact.poisson_ratio", "fluid.viscosity", "fluid.density", "fluid.sph_spacing", "fluid.sound_speed",
-    "drive.mason", "drive.shear_rate", "drive.strain", "drive.warmup_strain", "numerics.dt", "numerics.skin",
-    "numerics.dt_safety", "numerics.implicit_tol", "scene.model", "numerics.integrator", "scene.seed",
-    "numerics.threads", "numerics.implicit_order", "output.every", "output.frames"};
-constexpr std::size_t k_fingerprint_fields = std::size(k_fingerprint_keys);
-// numerics.newton_tol came later: only a value other than the default
-// enters, so that the scene_id of every earlier scene stays what it was
-constexpr const char* k_newton_tol_tag = "newton_tol ";
-
-std::string hex(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%a", v);
-  return buf;
-}
-}  // namespace
-
-std::string scene_fingerprint(const SceneConfig& c) {
-  const std::string values[] = {
-      hex(c.gap), hex(c.ly), hex(c.lz), hex(c.radius), hex(c.volume_fraction), hex(c.density), hex(c.magnetization),
-      hex(c.dipole_cutoff), hex(c.wall_spacing), hex(c.youngs_modulus), hex(c.poisson_ratio), hex(c.viscosity),
-      hex(c.fluid_density), hex(c.sph_spacing), hex(c.sound_speed), hex(c.mason), hex(c.shear_rate), hex(c.strain),
-      hex(c.warmup_strain), hex(c.dt.value_or(-1.0)), hex(c.skin), hex(c.dt_safety), hex(c.implicit_tol),
-      to_string(c.model), to_string(c.integrator), std::to_string(c.seed), std::to_string(c.threads),
-      std::to_string(c.implicit_order), std::to_string(c.every), std::to_string(c.frames)};
-  static_assert(std::size(values) == k_fingerprint_fields, "one key per fingerprint field");
-  std::string out;
-  for (const std::string& v : values) out += (out.empty() ? "" : ";") + v;
-  if (c.newton_tol != 1e-6)  // the default when the key came; a literal, so a new default cannot alias it
-    out += ";" + std::string(k_newton_tol_tag) + hex(c.newton_tol);
-  return out;
-}
-
-std::string fingerprint_difference(const std::string& was, const std::string& now) {
-  // key -> value as written, numbers in %g (a hex float parses with strtod)
-  auto fields = [](const std::string& fp) {
-    std::vector<std::pair<std::string, std::string>> out;
-    std::size_t start = 0;
-    for (std::size_t k = 0; start <= fp.size(); ++k) {
-      const std::size_t end = std::min(fp.find(';', start), fp.size());
-      std::string text = fp.substr(start, end - start);
-      std::string key = k < k_fingerprint_fields ? k_fingerprint_keys[k] : "field " + std::to_string(k + 1);
-      if (text.rfind(k_newton_tol_tag, 0) == 0) key = "numerics.newton_tol", text.erase(0, std::strlen(k_newton_tol_tag));
-      if (text.rfind("0x", 0) == 0 || text.rfind("-0x", 0) == 0) {
-        char buf[32];
-        std::snprintf(buf, sizeof buf, "%.10g", std::strtod(text.c_str(), nullptr));
-        text = buf;
-      }
-      out.emplace_back(key, text);
-      start = end + 1;
-    }
-    return out;
-  };
-  const auto a = fields(was), b = fields(now);
-  auto value_in = [](const std::vector<std::pair<std::string, std::string>>& f, const std::string& key) {
-    for (const auto& [k, v] : f)
-      if (k == key) return v;
-    return std::string(key == "numerics.newton_tol" ? "1e-06 (default)" : "absent");
-  };
-  std::vector<std::string> keys;
-  for (const auto& f : {a, b})
-    for (const auto& [k, v] : f)
-      if (std::find(keys.begin(), keys.end(), k) == keys.end()) keys.push_back(k);
-  std::string out;
-  for (const std::string& k : keys) {
-    const std::string va = value_in(a, k), vb = value_in(b, k);
-    if (va != vb) out += (out.empty() ? "" : "; ") + k + " " + va + " in the checkpoint, " + vb + " now";
-  }
-  return out;
-}
-
-std::string fingerprint_id(const std::string& fingerprint) {
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "%08x", static_cast<unsigned>(crc32(fingerprint)));
-  return buf;
-}
-
-std::string scene_id(const SceneConfig& c) { return fingerprint_id(scene_fingerprint(c)); }
 
 RunFiles::RunFiles(const RunOptions& opt, const SceneConfig& c)
     : opt_(opt),

@@ -88,7 +88,8 @@ double estimate_point_seconds(const std::string& scene_path, const std::vector<s
 }
 
 PointEstimates estimate_points(const SweepSpec& spec, const std::vector<SweepPoint>& points, const std::string& out_dir,
-                               double cost_rate, const std::string& archive_dir, const std::string& calibrate_dir) {
+                               double cost_rate, const std::string& archive_dir,
+                               const std::vector<std::string>& calibrate_dirs) {
   struct Measured {
     std::string model;
     double log_mn, per_strain, wall;
@@ -108,11 +109,18 @@ PointEstimates estimate_points(const SweepSpec& spec, const std::vector<SweepPoi
       // variants: the same model, Mn and seed there calibrate too
       std::string plain = points[k].dir;
       if (!points[k].variant.empty()) plain.erase(points[k].model.size() + 1, points[k].variant.size() + 1);
+      // where to look, in order: the archive, then each calibration folder
+      // for the point itself and then for its plain form
+      std::vector<std::filesystem::path> where;
+      if (!archive_dir.empty()) where.push_back(std::filesystem::path(archive_dir) / points[k].dir);
+      for (const std::string& d : calibrate_dirs) {
+        where.push_back(std::filesystem::path(d) / points[k].dir);
+        where.push_back(std::filesystem::path(d) / plain);
+      }
       bool found = false;
-      for (const auto& [d, rel] : {std::pair{&archive_dir, points[k].dir}, std::pair{&calibrate_dir, points[k].dir},
-                                   std::pair{&calibrate_dir, plain}})
-        if (!found && !d->empty() && std::filesystem::exists(std::filesystem::path(*d) / rel / "summary.json")) {
-          path = std::filesystem::path(*d) / rel / "summary.json";
+      for (const auto& w : where)
+        if (!found && std::filesystem::exists(w / "summary.json")) {
+          path = w / "summary.json";
           found = true;
         }
       if (!found) continue;
@@ -137,12 +145,11 @@ PointEstimates estimate_points(const SweepSpec& spec, const std::vector<SweepPoi
     // its own earlier run (stale, archived or in the calibration folder)
     // first, else the nearest Mn of the model
     const Measured* near = done[k].per_strain > 0 ? &done[k] : nullptr;
-    for (const Measured& m : done) {
-      if (done[k].per_strain > 0) break;
-      if (m.per_strain > 0 && m.model == points[k].model &&
-          (!near || std::abs(m.log_mn - std::log(points[k].mason)) < std::abs(near->log_mn - std::log(points[k].mason))))
-        near = &m;
-    }
+    if (!near)
+      for (const Measured& m : done)
+        if (m.per_strain > 0 && m.model == points[k].model &&
+            (!near || std::abs(m.log_mn - std::log(points[k].mason)) < std::abs(near->log_mn - std::log(points[k].mason))))
+          near = &m;
     if (near) {
       try {
         e.seconds[k] = near->per_strain * load_scene(spec.scene_path, points[k].sets).config.strain;

@@ -119,7 +119,7 @@ struct SweepOptions {
   bool write_csv = true;           // rewrite sweep.csv at the end (MPI workers leave it to rank 0)
   double cost_rate = 1e6;   // particle-steps per second assumed by the first estimate
   std::string archive;      // non-empty: a sweep archive (below), restored from first, added to as points finish
-  std::string calibrate;    // non-empty: summaries that calibrate the estimates only (estimate_points)
+  std::vector<std::string> calibrate;  // folders of summaries that calibrate the estimates only (estimate_points)
 };
 
 struct SweepOutcome {
@@ -140,18 +140,19 @@ double estimate_point_seconds(const std::string& scene_path, const std::vector<s
 // the implicit schemes' step sizes, only where no point of the model has
 // finished). `calibrated[k]` says which of the two an estimate is. With an
 // archive (--archive), its summaries calibrate too, by their seconds per
-// strain unit, where out_dir has none; so do those of calibrate_dir
-// (--calibrate-from: a folder laid out like an archive, read for the cost
-// alone and never restored), where neither has the point; for a point of a
-// variant, the same model, Mn and seed without the variant level there
-// calibrates too (a convergence sweep estimated from its base sweep).
+// strain unit, where out_dir has none; so do those of calibrate_dirs
+// (--calibrate-from, repeatable: folders laid out like an archive, read for
+// the cost alone and never restored), the first that has the point, where
+// neither has it; for a point of a variant, the same model, Mn and seed
+// without the variant level there calibrates too (a convergence sweep
+// estimated from its own earlier runs, then from its base sweep).
 struct PointEstimates {
   std::vector<double> seconds;
   std::vector<char> calibrated;
 };
 PointEstimates estimate_points(const SweepSpec& spec, const std::vector<SweepPoint>& points, const std::string& out_dir,
                                double cost_rate, const std::string& archive_dir = {},
-                               const std::string& calibrate_dir = {});
+                               const std::vector<std::string>& calibrate_dirs = {});
 
 // Runs this rank's unfinished points one after another into out_dir/<point.dir>
 // (every scene is loaded and validated before the first run, and so is the

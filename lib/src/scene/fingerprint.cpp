@@ -1,0 +1,121 @@
+// The scene fingerprint (every parameter of a scene, exactly: what a
+// checkpoint resumes into and what a sweep archive's scene_id hashes), and
+// what two fingerprints disagree on. Declared in scene/run_series.hpp.
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <iterator>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "mrf/io/checksum.hpp"
+#include "mrf/scene/run_series.hpp"
+
+namespace mrf {
+
+namespace {
+// The scene keys a fingerprint holds, in its order (the order is part of
+// every archived scene_id: append, never reorder).
+constexpr const char* k_fingerprint_keys[] = {
+    "box.gap", "box.ly", "box.lz", "particles.radius", "particles.volume_fraction", "particles.density",
+    "particles.magnetization", "particles.dipole_cutoff", "walls.spacing", "contact.youngs_modulus",
+    "contact.poisson_ratio", "fluid.viscosity", "fluid.density", "fluid.sph_spacing", "fluid.sound_speed",
+    "drive.mason", "drive.shear_rate", "drive.strain", "drive.warmup_strain", "numerics.dt", "numerics.skin",
+    "numerics.dt_safety", "numerics.implicit_tol", "scene.model", "numerics.integrator", "scene.seed",
+    "numerics.threads", "numerics.implicit_order", "output.every", "output.frames"};
+constexpr std::size_t k_fingerprint_fields = std::size(k_fingerprint_keys);
+// numerics.newton_tol came later: only a value other than the default
+// enters, so that the scene_id of every earlier scene stays what it was
+constexpr const char* k_newton_tol_tag = "newton_tol ";
+
+std::string hex(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%a", v);
+  return buf;
+}
+}  // namespace
+
+std::string scene_fingerprint(const SceneConfig& c) {
+  const std::string values[] = {
+      hex(c.gap), hex(c.ly), hex(c.lz), hex(c.radius), hex(c.volume_fraction), hex(c.density), hex(c.magnetization),
+      hex(c.dipole_cutoff), hex(c.wall_spacing), hex(c.youngs_modulus), hex(c.poisson_ratio), hex(c.viscosity),
+      hex(c.fluid_density), hex(c.sph_spacing), hex(c.sound_speed), hex(c.mason), hex(c.shear_rate), hex(c.strain),
+      hex(c.warmup_strain), hex(c.dt.value_or(-1.0)), hex(c.skin), hex(c.dt_safety), hex(c.implicit_tol),
+      to_string(c.model), to_string(c.integrator), std::to_string(c.seed), std::to_string(c.threads),
+      std::to_string(c.implicit_order), std::to_string(c.every), std::to_string(c.frames)};
+  static_assert(std::size(values) == k_fingerprint_fields, "one key per fingerprint field");
+  std::string out;
+  for (const std::string& v : values) {
+    if (!out.empty()) out += ';';
+    out += v;
+  }
+  if (c.newton_tol != 1e-6) {  // the default when the key came; a literal, so a new default cannot alias it
+    out += ';';
+    out += k_newton_tol_tag;
+    out += hex(c.newton_tol);
+  }
+  return out;
+}
+
+std::string fingerprint_difference(const std::string& was, const std::string& now) {
+  if (was == now) return "";
+  // the fields as written (numbers in hex), keyed by position
+  auto fields = [](const std::string& fp) {
+    std::vector<std::pair<std::string, std::string>> out;
+    for (std::size_t start = 0, k = 0; start <= fp.size(); ++k) {
+      const std::size_t end = std::min(fp.find(';', start), fp.size());
+      std::string text = fp.substr(start, end - start);
+      std::string key = k < k_fingerprint_fields ? k_fingerprint_keys[k] : "field " + std::to_string(k + 1);
+      if (text.rfind(k_newton_tol_tag, 0) == 0) key = "numerics.newton_tol", text.erase(0, std::strlen(k_newton_tol_tag));
+      out.emplace_back(key, text);
+      start = end + 1;
+    }
+    return out;
+  };
+  const auto a = fields(was), b = fields(now);
+  const auto base = [](const std::vector<std::pair<std::string, std::string>>& f) {
+    return f.size() - (f.back().first == "numerics.newton_tol" ? 1 : 0);
+  };
+  if (base(a) != k_fingerprint_fields || base(b) != k_fingerprint_fields)
+    return "the checkpoint's scene fingerprint has " + std::to_string(base(a)) + " fields where this version writes " +
+           std::to_string(k_fingerprint_fields) + ": it comes from another version of mrf";
+  // a value for display: a number in %.10g, or in %.17g where the two
+  // values differ beyond ten digits; numerics.dt -1 is "auto"
+  auto show = [](const std::string& key, const std::string& text, int digits) {
+    if (text.rfind("0x", 0) != 0 && text.rfind("-0x", 0) != 0) return text;
+    const double v = std::strtod(text.c_str(), nullptr);
+    if (key == "numerics.dt" && v == -1.0) return std::string("auto");
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+    return std::string(buf);
+  };
+  auto value_in = [](const std::vector<std::pair<std::string, std::string>>& f, const std::string& key) {
+    for (const auto& [k, v] : f)
+      if (k == key) return v;
+    return std::string();  // numerics.newton_tol at its default
+  };
+  std::string out;
+  for (std::size_t k = 0; k <= k_fingerprint_fields; ++k) {
+    const std::string key = k < k_fingerprint_fields ? k_fingerprint_keys[k] : "numerics.newton_tol";
+    const std::string va = value_in(a, key), vb = value_in(b, key);
+    if (va == vb) continue;
+    std::string sa = show(key, va, 10), sb = show(key, vb, 10);
+    if (sa == sb) sa = show(key, va, 17), sb = show(key, vb, 17);
+    if (va.empty()) sa = "1e-06 (default)";
+    if (vb.empty()) sb = "1e-06 (default)";
+    out += (out.empty() ? "" : "; ") + key + " " + sa + " in the checkpoint, " + sb + " now";
+  }
+  return out.empty() ? "the fingerprints differ in no named key" : out;
+}
+
+std::string fingerprint_id(const std::string& fingerprint) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "%08x", static_cast<unsigned>(crc32(fingerprint)));
+  return buf;
+}
+
+std::string scene_id(const SceneConfig& c) { return fingerprint_id(scene_fingerprint(c)); }
+
+}  // namespace mrf
