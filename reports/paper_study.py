@@ -11,7 +11,8 @@ usage: paper_study.py SWEEP_DIR OUT_DIR [--small reports/study/flow_curves.csv]
                       [--fixed-m reports/study/paper/fixed_m_sweep.csv]
                       [--fixed-m-criterion reports/study/paper/fixed_m_criterion.json]
                       [--aqs-seeds headline_0.45,seed2,seed3]
-                      [--first-runs reports/study/paper/first_runs] [--note TEXT]
+                      [--first-runs reports/study/paper/first_runs]
+                      [--second-runs reports/study/paper/second_runs] [--note TEXT]
                       [--small-criterion reports/study/criterion_default.json]
                       [--reanalysed reports/study/paper/reanalysed.json]
                       [--convergence reports/study/paper/convergence.md]
@@ -30,8 +31,9 @@ beside the lowest-Mn particle stresses; the star is the value to quote, the
 mean of the seed realisations named by --aqs-seeds (over their common
 window) with the standard error of their scatter.
 
---first-runs: the summaries of the first runs of points re-run for
-steadiness, listed under the steadiness table with what their re-runs gave.
+--first-runs, --second-runs: the summaries of the first and second runs of
+points re-run for steadiness (reports/study/paper/first_runs/, second_runs/),
+listed under the steadiness table with what their re-runs gave.
 --note: a paragraph under the title (what state the report is in).
 --reanalysed: `mrf reanalyse` records of archived runs (scripts/paper_interim.py
 writes them from the archive's window_series.csv files), for a post-hoc
@@ -481,13 +483,13 @@ def sweep_cost(rows, firsts):
     for r in rows:
         per[r["model"]] += num(r, "wall_seconds")
     current = {(r["model"], float(r["mason"]), int(r["seed"])): num(r, "strain") for r in rows}
-    # a first run counts only once its re-run (another strain) has replaced it
+    # an earlier run counts only once a re-run (another strain) has replaced it
     firsts = [f for f in firsts if current.get((f["model"], float(f["mason"]), int(f["seed"]))) not in (None, f["strain"])]
     first = sum(f.get("wall_seconds", 0.0) for f in firsts)
     total = sum(per.values()) + first
     return ["Whole-sweep wall time (one thread per run, summed over runs; shared machine, an upper bound): "
             + ", ".join(f"{k} {per[k] / 3600:.1f} h" for k in ORDER if k in per)
-            + f", the first runs replaced by re-runs {first / 3600:.1f} h; **{total / 3600:.1f} core-hours** in all "
+            + f", the earlier runs replaced by re-runs {first / 3600:.1f} h; **{total / 3600:.1f} core-hours** in all "
             f"({len(rows)} runs counted, {len(firsts)} replaced).", ""]
 
 
@@ -640,21 +642,24 @@ def main(argv):
                   f"{len(bad)} of them fail: " + (", ".join(f"{m} Mn {mn:g} seed {sd}" for m, mn, sd in bad) or "none")
                   + ". These runs were seen before the rule was written: this is a reading, not a test of the rule, "
                   "and the tables above keep them 'untested'."]
-    # The first runs of points re-run for steadiness (their summaries kept
-    # in first_runs/ before the re-run overwrote the archive entry).
-    first_dir = arg(argv, "--first-runs", os.path.join(here, "study", "paper", "first_runs"))
+    # The earlier runs of points re-run for steadiness (their summaries kept
+    # in first_runs/ and second_runs/ before a re-run overwrote the archive
+    # entry), each marked with its run number.
     firsts = []
-    for dirpath, _, files in sorted(os.walk(first_dir)) if os.path.isdir(first_dir) else []:
-        if "summary.json" in files:
-            firsts.append(json.load(open(os.path.join(dirpath, "summary.json"))))
+    for number, key, sub in ((1, "--first-runs", "first_runs"), (2, "--second-runs", "second_runs")):
+        folder = arg(argv, key, os.path.join(here, "study", "paper", sub))
+        for dirpath, _, files in sorted(os.walk(folder)) if os.path.isdir(folder) else []:
+            if "summary.json" in files:
+                firsts.append(dict(json.load(open(os.path.join(dirpath, "summary.json"))), run_number=number))
     current = {(r["model"], float(r["mason"]), int(r["seed"])): r for r in rows}
     if firsts:
-        lines += ["", "First runs of the points re-run with strain and warm-up doubled (the policy: the re-run "
-                  "rules of experiments/sweeps/paper_realistic.toml); 'in the table above' when the first run is "
-                  "what the tables use (its re-run has not finished).", "",
-                  "| model | Mn | seed | strain (warm-up) | drift z | MSER discard | steady | re-run |",
-                  "|---|---:|---:|---:|---:|---:|---|---|"]
-        for f in sorted(firsts, key=lambda f: (ORDER.index(f["model"]), f["mason"], f["seed"])):
+        lines += ["", "Earlier runs of the points re-run for steadiness: run 1, the first run (re-run with strain and "
+                  "warm-up doubled, session 21's rules); run 2, a re-run that failed again (run once more at 4x the "
+                  "first run's strain, session 27's rule); both at the end of experiments/sweeps/paper_realistic.toml. "
+                  "'in the table above' when that run is what the tables use (its re-run has not finished).", "",
+                  "| model | Mn | seed | run | strain (warm-up) | drift z | MSER discard | steady | what the tables use now |",
+                  "|---|---:|---:|---:|---:|---:|---:|---|---|"]
+        for f in sorted(firsts, key=lambda f: (ORDER.index(f["model"]), f["mason"], f["seed"], f["run_number"])):
             now = current.get((f["model"], float(f["mason"]), int(f["seed"])))
             if now is None:
                 state = "pending; not in the tables"
@@ -664,7 +669,8 @@ def main(argv):
                 state = (f"{num(now, 'strain'):g} ({num(now, 'warmup_strain'):g}): z {num(now, 'stress_total_drift_z'):+.2f}, "
                          f"MSER {num(now, 'steady_mser_discard_fraction'):.3f}, {'steady' if steady(now) else '**not steady**'}")
             ok = abs(f["stress_total_drift_z"]) < DRIFT_Z and f["steady_mser_discard_fraction"] < MSER_MAX
-            lines.append(f"| {f['model']} | {f['mason']:g} | {f['seed']} | {f['strain']:g} ({f['warmup_strain']:g}) | "
+            lines.append(f"| {f['model']} | {f['mason']:g} | {f['seed']} | {f['run_number']} | "
+                         f"{f['strain']:g} ({f['warmup_strain']:g}) | "
                          f"{f['stress_total_drift_z']:+.2f} | {f['steady_mser_discard_fraction']:.3f} | "
                          f"{'yes' if ok else '**no**'} | {state} |")
     lines += ["", "Cost: wall seconds per strain unit of each run, one thread, on a shared 2-core machine "
