@@ -217,19 +217,39 @@ long ContactDual::solve_cg(const std::vector<ContactPair>& pairs, double rtol) {
       if (!coupled_) packed_[a] = {n_[e], mob[c.i], mob_k, comp_[e], c.i, c.wall ? spare : c.k};
     }
   });
-  auto apply_a = [&](const std::vector<double>& p, std::vector<double>& out) { apply(pairs, p, out); };
-  const bool ic0 = uses_ic0();
-  if (ic0 && factor_ic0(pairs))
-    return pcg(
-        r_, rtol, 10 * static_cast<long>(m) + 10, apply_a,
-        [&](const std::vector<double>& r, std::vector<double>& z) { apply_ic0(r, z); }, d_, cg_);
+  ic0_ready_ = uses_ic0() && factor_ic0(pairs);
   return pcg(
-      r_, rtol, 10 * static_cast<long>(m) + 10, apply_a,
-      [&](const std::vector<double>& r, std::vector<double>& z) {
-        z.resize(r.size());
-        for (std::size_t a = 0; a < r.size(); ++a) z[a] = r[a] / diag_[a];
-      },
-      d_, cg_);
+      r_, rtol, 10 * static_cast<long>(m) + 10,
+      [&](const std::vector<double>& p, std::vector<double>& out) { apply(pairs, p, out); },
+      [&](const std::vector<double>& r, std::vector<double>& z) { precondition(r, z); }, d_, cg_);
+}
+
+void ContactDual::precondition(const std::vector<double>& r, std::vector<double>& z) const {
+  if (ic0_ready_) {
+    apply_ic0(r, z);
+    return;
+  }
+  z.resize(r.size());
+  for (std::size_t a = 0; a < r.size(); ++a) z[a] = r[a] / diag_[a];
+}
+
+long ContactDual::resolve_clipped(const std::vector<ContactPair>& pairs, double rtol) {
+  const std::size_t m = act_.size();
+  clipped_.assign(m, 0);
+  bool any = false;
+  for (std::size_t a = 0; a < m; ++a)
+    if (lambda_[act_[a]] + d_[a] < 0) clipped_[a] = 1, any = true;
+  if (!any) return 0;
+  zero_force_.assign(m, 0.0);
+  for (std::size_t a = 0; a < m; ++a) {
+    if (clipped_[a]) zero_force_[a] = -lambda_[act_[a]];
+    r_[a] = rhs_[act_[a]];  // solve_cg's right-hand side, by active contact
+  }
+  const std::vector<double> first = d_;
+  return pcg_fixed(
+      r_, clipped_, zero_force_, first, rtol, 10 * static_cast<long>(m) + 10,
+      [&](const std::vector<double>& p, std::vector<double>& out) { apply(pairs, p, out); },
+      [&](const std::vector<double>& r, std::vector<double>& z) { precondition(r, z); }, d_, cg_);
 }
 
 bool ContactDual::factor_ic0(const std::vector<ContactPair>& pairs) {
@@ -389,6 +409,10 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
   std::vector<Worst> worst_of(static_cast<std::size_t>(std::max(pair_blocks, 1)));
   NewtonResult res;
   double prev_worst = 0, theta = 1.0;
+  // the largest residual of the last two accepted iterates, and whether the
+  // solve has stalled (see resolve_clipped)
+  double worst_1 = 0, worst_2 = 0;
+  bool stalled = false;
   for (res.iterations = 1; res.iterations <= opt.max_iterations; ++res.iterations) {
     // Residuals at y, normals updated to y; y_next = b + M G(y) lambda. By
     // blocks of pairs, each listing its active pairs, joined in order.
@@ -472,6 +496,10 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
       return res;
     }
     res.linear_iterations += solve_cg(pairs, opt.linear_rtol);
+    if (res.iterations >= 4 && worst > 0.5 * worst_2) stalled = true;
+    worst_2 = worst_1;
+    worst_1 = worst;
+    if (stalled) res.linear_iterations += resolve_clipped(pairs, opt.linear_rtol);
     y.swap(y_next_);
     lambda_prev_ = lambda_;  // for a backtrack
     y_prev_ = y;

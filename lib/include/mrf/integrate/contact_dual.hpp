@@ -20,7 +20,9 @@
 // correction, so Newton needs few iterations from the forces of the last step.
 // Open contacts are handled by projection (lambda >= 0) with an active set;
 // an update that more than doubles the largest residual is halved (down to
-// 1/8 of the Newton step), which stops the active set cycling.
+// 1/8 of the Newton step), and once a solve stalls the update is made
+// consistent with the contacts it clips (resolve_clipped): together they
+// stop the active set cycling.
 #pragma once
 #include <cstdint>
 #include <utility>
@@ -68,6 +70,19 @@ class ContactDual {
   // (A + C) p on the active set
   void apply(const std::vector<ContactPair>& pairs, const std::vector<double>& p, std::vector<double>& out);
   long solve_cg(const std::vector<ContactPair>& pairs, double rtol);
+  // z = M^-1 r: IC(0) where solve_cg factored it, Jacobi otherwise
+  void precondition(const std::vector<double>& r, std::vector<double>& z) const;
+  // Once a solve has stalled (from its fourth iteration, the largest
+  // residual not halved over two iterations), the Newton update is made
+  // consistent where the projection would clip it: the contacts whose
+  // update goes below zero force are fixed at zero and the others solved
+  // again with that change on the right-hand side (pcg_fixed, from the
+  // first solve's values). Without it the rest of the update assumes the
+  // clipped contacts still pull, the spheres overshoot, and the solve can
+  // cycle (a sphere against two nearly parallel wall spheres took turns
+  // with a neighbour: docs/performance.md, session 27). Returns the CG
+  // iterations.
+  long resolve_clipped(const std::vector<ContactPair>& pairs, double rtol);
   // Incomplete Cholesky IC(0) of the assembled A + C on the active set,
   // the CG preconditioner. The coupled part s G^T C G enters by its
   // diagonal and by the entries of contact pairs that share a sphere when
@@ -104,6 +119,9 @@ class ContactDual {
   int sphere_blocks_ = 1;  // blocks of the passes over the spheres: 1, a pass over the contacts instead
   std::vector<double> d_, r_, diag_, dq_;           // CG on the active set: solution, right-hand side, Jacobi diagonal
   PcgScratch<double> cg_;
+  bool ic0_ready_ = false;             // solve_cg factored IC(0) for this linear solve
+  std::vector<char> clipped_;          // resolve_clipped: per active contact
+  std::vector<double> zero_force_;
   // The last Newton update, for a backtrack: forces, positions and normals
   // before it, its active set and its direction.
   std::vector<double> lambda_prev_, d_prev_;
