@@ -241,11 +241,9 @@ long ContactDual::resolve_clipped(const std::vector<ContactPair>& pairs, double 
     if (lambda_[act_[a]] + d_[a] < 0) clipped_[a] = 1, any = true;
   if (!any) return 0;
   zero_force_.assign(m, 0.0);
-  for (std::size_t a = 0; a < m; ++a) {
+  for (std::size_t a = 0; a < m; ++a)
     if (clipped_[a]) zero_force_[a] = -lambda_[act_[a]];
-    r_[a] = rhs_[act_[a]];  // solve_cg's right-hand side, by active contact
-  }
-  const std::vector<double> first = d_;
+  const std::vector<double> first = d_;  // r_ still holds solve_cg's right-hand side (pcg works on a copy)
   return pcg_fixed(
       r_, clipped_, zero_force_, first, rtol, 10 * static_cast<long>(m) + 10,
       [&](const std::vector<double>& p, std::vector<double>& out) { apply(pairs, p, out); },
