@@ -3,8 +3,8 @@
 #include <omp.h>
 
 #include <algorithm>
-#include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace mrf::detail {
@@ -13,13 +13,15 @@ namespace mrf::detail {
 // [block_bound(n, blk, blocks), block_bound(n, blk + 1, blocks))).
 inline std::size_t block_bound(std::size_t n, std::size_t blk, std::size_t blocks) { return n * blk / blocks; }
 
-// The same for rows whose work falls linearly to 0 along [0, n), as row i
-// of a half pair list (partners j > i) in an order unrelated to space: the
-// blocks hold equal shares of n - i, ending at n (1 - sqrt(1 - blk/blocks)).
-inline std::size_t triangle_bound(std::size_t n, std::size_t blk, std::size_t blocks) {
-  if (blk >= blocks) return n;
-  const double x = 1.0 - std::sqrt(1.0 - static_cast<double>(blk) / static_cast<double>(blocks));
-  return std::min(n, static_cast<std::size_t>(x * static_cast<double>(n)));
+// The same for rows of unequal work, row r's work start[r + 1] - start[r]
+// (the row starts of a pair list, start.size() = rows + 1): the blocks hold
+// equal shares of the total, a block ending at the first row start at or
+// past its share.
+inline std::size_t share_bound(const std::vector<std::uint32_t>& start, std::size_t blk, std::size_t blocks) {
+  if (blk == 0 || start.empty()) return 0;
+  if (blk >= blocks) return start.size() - 1;
+  const auto target = static_cast<std::uint32_t>(static_cast<std::size_t>(start.back()) * blk / blocks);
+  return static_cast<std::size_t>(std::lower_bound(start.begin(), start.end() - 1, target) - start.begin());
 }
 
 // The number of blocks for a pass over n items: one per thread when

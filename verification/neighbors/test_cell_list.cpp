@@ -85,6 +85,40 @@ TEST_P(CellListVsBruteForce, PairRowsOnThreadsEqualTheSerialBuild) {
   EXPECT_EQ(sorted(flat), sorted(brute_force_self_pairs(pts, box, rc)));
 }
 
+// A rebuild cuts its row blocks by the last list's shares (any numbering):
+// still the serial rows, for 1, 2 and 3 threads, after the points moved.
+TEST_P(CellListVsBruteForce, RebuiltPairRowsOnThreadsEqualTheSerialBuild) {
+  const auto [box, rc] = GetParam();
+  auto pts = random_points(3001, box, 41);
+  std::sort(pts.begin(), pts.end(), [](const Vec3& a, const Vec3& b) { return a.x() < b.x(); });  // slabs
+  auto moved = pts;
+  std::mt19937_64 rng(42);
+  std::uniform_real_distribution<double> u(-0.3 * rc, 0.3 * rc);
+  for (auto& q : moved) {
+    q += Vec3(u(rng), u(rng), u(rng));
+    q.x() = std::clamp(q.x(), -box.gap / 2, box.gap / 2);
+  }
+  const int saved = omp_get_max_threads();
+  std::vector<PairRows> by_threads;
+  for (int t : {1, 2, 3}) {
+    omp_set_num_threads(t);
+    PairRows rows;
+    self_pair_rows(pts, box, rc, rows);
+    self_pair_rows(moved, box, rc, rows);
+    by_threads.push_back(rows);
+  }
+  omp_set_num_threads(saved);
+  for (std::size_t t = 1; t < by_threads.size(); ++t) {
+    EXPECT_EQ(by_threads[t].start, by_threads[0].start) << t + 1 << " threads";
+    EXPECT_EQ(by_threads[t].k, by_threads[0].k) << t + 1 << " threads";
+  }
+  std::vector<IndexPair> flat;
+  const PairRows& rows = by_threads[1];
+  for (std::uint32_t i = 0; i < moved.size(); ++i)
+    for (std::uint32_t n = rows.start[i]; n < rows.start[i + 1]; ++n) flat.emplace_back(i, rows.k[n]);
+  EXPECT_EQ(sorted(flat), sorted(brute_force_self_pairs(moved, box, rc)));
+}
+
 TEST_P(CellListVsBruteForce, CrossPairsIdentical) {
   const auto [box, rc] = GetParam();
   const auto a = random_points(300, box, 11);

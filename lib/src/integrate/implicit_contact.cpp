@@ -47,7 +47,7 @@ void contact_candidates(const DemPairLists& lists, const std::vector<Vec3>& x, c
 void near_pairs(const PairRows& ff, const std::vector<Vec3>& x, const Box& box, double reach,
                 std::vector<ContactPair>& out) {
   const double reach2 = reach * reach;
-  // rows of a half list: cut for equal shares of its pairs (triangle_bound)
+  // rows of a half list: cut for equal shares of its pairs
   detail::in_blocks(
       ff.rows(), k_candidate_rows_per_thread, out,
       [&](std::size_t r0, std::size_t r1, std::vector<ContactPair>& mine) {
@@ -61,7 +61,7 @@ void near_pairs(const PairRows& ff, const std::vector<Vec3>& x, const Box& box, 
         std::sort(mine.begin(), mine.end(),
                   [](const ContactPair& a, const ContactPair& b) { return a.i != b.i ? a.i < b.i : a.k < b.k; });
       },
-      &detail::triangle_bound);
+      [&ff](std::size_t, std::size_t blk, std::size_t blocks) { return detail::share_bound(ff.start, blk, blocks); });
 }
 
 void contact_candidates(const std::vector<ContactPair>& ff_near, const std::vector<IndexPair>& fw,

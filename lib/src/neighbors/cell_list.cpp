@@ -91,6 +91,9 @@ std::uint32_t checked_index(std::size_t n, const char* what) {
 }
 
 void self_pair_rows(const std::vector<Vec3>& pts, const Box& box, double cutoff, PairRows& out) {
+  // the last list's row starts, if it was a list of these spheres (below)
+  std::vector<std::uint32_t> last;
+  if (out.start.size() == pts.size() + 1) last.swap(out.start);
   out.k.clear();
   out.start.assign(pts.empty() ? 0 : pts.size() + 1, 0);
   if (pts.empty()) return;
@@ -103,10 +106,15 @@ void self_pair_rows(const std::vector<Vec3>& pts, const Box& box, double cutoff,
   // Rows in blocks on threads (detail::in_blocks): each block's partners in
   // its own list, row ends counted within the block and shifted to the
   // joined list after, so the rows are the serial ones whatever the threads.
-  // Row i holds the partners j > i, so its share of the pairs falls as i
-  // grows: the blocks are cut for equal shares (equal blocks of rows left
-  // the first thread 70 % of the work on the paper cell).
+  // Row i holds the partners j > i, so how the pairs fall into rows depends
+  // on the spheres' order (in a random order, row i's share falls as i
+  // grows: equal blocks of rows left the first thread 70 % of the work on
+  // the paper cell). The blocks are cut for equal shares of the last list's
+  // pairs, which a rebuild changes little; equal blocks for a first list.
   const std::size_t n = pts.size();
+  const auto bound = [&last](std::size_t rows, std::size_t blk, std::size_t blocks) {
+    return last.empty() ? detail::block_bound(rows, blk, blocks) : detail::share_bound(last, blk, blocks);
+  };
   const std::vector<std::size_t> begin = detail::in_blocks(
       n, k_rows_per_thread, out.k,
       [&](std::size_t r0, std::size_t r1, std::vector<std::uint32_t>& mine) {
@@ -119,10 +127,10 @@ void self_pair_rows(const std::vector<Vec3>& pts, const Box& box, double cutoff,
           out.start[i + 1] = checked_index(mine.size(), "pair list");
         }
       },
-      &detail::triangle_bound);
+      bound);
   const std::size_t blocks = begin.size();
   for (std::size_t b = 1; b < blocks; ++b)
-    for (std::size_t i = detail::triangle_bound(n, b, blocks); i < detail::triangle_bound(n, b + 1, blocks); ++i)
+    for (std::size_t i = bound(n, b, blocks); i < bound(n, b + 1, blocks); ++i)
       out.start[i + 1] = checked_index(out.start[i + 1] + begin[b], "pair list");
 }
 

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 
+#include "parallel_blocks.hpp"
+
 namespace mrf {
 
 void PairSums::merge(const PairSums& o) {
@@ -26,12 +28,7 @@ namespace detail {
 // Rows split so each thread gets about the same number of pairs (depends on
 // the list alone: deterministic).
 std::size_t row_chunk(const PairRows& rows, int t, int nt) {
-  const std::size_t nrows = rows.rows();
-  if (t == 0) return 0;
-  if (t == nt) return nrows;
-  const std::size_t target = rows.size() * static_cast<std::size_t>(t) / static_cast<std::size_t>(nt);
-  const auto it = std::lower_bound(rows.start.begin(), rows.start.end() - 1, static_cast<std::uint32_t>(target));
-  return static_cast<std::size_t>(it - rows.start.begin());
+  return detail::share_bound(rows.start, static_cast<std::size_t>(t), static_cast<std::size_t>(nt));
 }
 
 std::size_t chunk(std::size_t n, int t, int nt) { return n * static_cast<std::size_t>(t) / static_cast<std::size_t>(nt); }

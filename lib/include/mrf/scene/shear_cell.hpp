@@ -24,7 +24,8 @@ std::size_t particle_count(const SceneConfig& c);
 
 // Random sequential addition, seeded and reproducible on every platform:
 // centres uniform in y, z and in |x| <= gap/2 - 2R (clear of the wall
-// spheres), no two closer than 2R. Throws InputError on
+// spheres), no two closer than 2R, numbered in slabs across the gap (by
+// x, then y, then z: an order that shear along z keeps). Throws InputError on
 // particles.volume_fraction when the fraction cannot be packed.
 FreeParticles place_particles(const SceneConfig& c, const std::string& where_phi = {});
 
