@@ -218,6 +218,7 @@ long ContactDual::solve_cg(const std::vector<ContactPair>& pairs, double rtol) {
     }
   });
   ic0_ready_ = uses_ic0() && factor_ic0(pairs);
+  if (!coupled_ && !ic0_ready_) return solve_cg_jacobi(rtol, 10 * static_cast<long>(m) + 10);
   return pcg(
       r_, rtol, 10 * static_cast<long>(m) + 10,
       [&](const std::vector<double>& p, std::vector<double>& out) { apply(pairs, p, out); },

@@ -70,6 +70,9 @@ class ContactDual {
   // (A + C) p on the active set
   void apply(const std::vector<ContactPair>& pairs, const std::vector<double>& p, std::vector<double>& out);
   long solve_cg(const std::vector<ContactPair>& pairs, double rtol);
+  // solve_cg without a coupled mobility and with Jacobi: the whole CG in one
+  // parallel region (contact_dual_cg.cpp), d_ from zero
+  long solve_cg_jacobi(double rtol, long max_it);
   // z = M^-1 r: IC(0) where solve_cg factored it, Jacobi otherwise
   void precondition(const std::vector<double>& r, std::vector<double>& z) const;
   // Once a solve has stalled (from its fourth iteration, the largest
@@ -119,6 +122,7 @@ class ContactDual {
   int sphere_blocks_ = 1;  // blocks of the passes over the spheres: 1, a pass over the contacts instead
   std::vector<double> d_, r_, diag_, dq_;           // CG on the active set: solution, right-hand side, Jacobi diagonal
   PcgScratch<double> cg_;
+  std::vector<double> dot_part_;       // solve_cg_jacobi: partial sums of its dot products by chunk
   bool ic0_ready_ = false;             // solve_cg factored IC(0) for this linear solve
   std::vector<char> clipped_;          // resolve_clipped: per active contact
   std::vector<double> zero_force_;
