@@ -102,10 +102,10 @@ int sweep_command(const SweepArgs& a) {
     if (!std::filesystem::is_directory(d))
       throw mrf::InputError("--calibrate-from", d, "", "is not a folder (of finished points' summary.json)");
   opt.write_csv = !a.no_csv;
-  // --collect and --list read --out, so they restore the archive into it
-  // first (a run restores its own share, run_sweep); --estimate writes
-  // nothing and reads the archive where it is
-  if (!a.archive.empty() && (a.collect || a.list))
+  // --collect reads --out, so it restores the archive into it first (a run
+  // restores its own share, run_sweep); --list and --estimate write nothing
+  // and read the archive where it is
+  if (!a.archive.empty() && a.collect)
     mrf::report_archive(mrf::restore_from_archive(spec, mrf::sweep_points(spec), out, a.archive), a.archive, a.quiet);
   if (a.collect) {  // sweep.csv from the finished points, nothing run (while other ranks still work)
     const auto points = mrf::sweep_points(spec);
@@ -122,11 +122,17 @@ int sweep_command(const SweepArgs& a) {
                 "estimate (s; * = from the particle-steps model, no point of the model finished)");
     for (const auto& p : points) {
       const std::filesystem::path dir = std::filesystem::path(out) / p.dir;
-      const char* state = mrf::point_stale(spec, p, dir)                                           ? "stale"
-                          : std::filesystem::exists(dir / "summary.json")   ? "finished"
+      const std::filesystem::path entry = std::filesystem::path(a.archive) / p.dir;
+      // an archived summary of this scene counts as finished (a run restores it)
+      const bool archived = !a.archive.empty() && std::filesystem::exists(entry / "summary.json") &&
+                            !mrf::point_stale(spec, p, entry);
+      const char* state = mrf::point_stale(spec, p, dir)                    ? "stale"
+                          : std::filesystem::exists(dir / "summary.json") ? "finished"
+                          : archived                                        ? "archived"
                           : std::filesystem::exists(dir / "failure.json") ? "failed"
                           : std::filesystem::exists(dir / "checkpoint.bin") ? "started"
-                                                                              : "todo";
+                          : !a.archive.empty() && std::filesystem::exists(entry / "summary.json") ? "stale"
+                                                                                            : "todo";
       std::printf("%-5zu %-40s %-14s %-9g %-5llu %-9s %.3g%s\n", p.index, p.dir.c_str(), p.model.c_str(), p.mason,
                   static_cast<unsigned long long>(p.seed), state, est.seconds[p.index],
                   est.calibrated[p.index] ? "" : " *");

@@ -8,10 +8,12 @@
   the estimate; 1 of 2 points to run, and the "to run" seconds are point
   1's estimate alone.
 - The same from the archive alone (the output folder removed), which the
-  estimate reads where it is: it writes nothing into --out.
+  estimate reads where it is: it writes nothing into --out; nor does
+  --list, which calls point 0 "archived".
 - After a rule doubles point 0's strain (its run is now for another scene):
   2 of 2 to run, and point 0 is estimated by its own earlier run's seconds
-  per strain unit times the new strain (not by its old wall time).
+  per strain unit times the new strain (not by its old wall time); --list
+  calls it "stale".
 
 Usage: sweep_estimate_check.py MRF_BINARY SCENE WORKDIR
 """
@@ -46,6 +48,12 @@ def estimate(*extra):
     return per, float(run.group(1)), int(run.group(2)), int(run.group(3)), float(tot.group(1))
 
 
+def list_states(*extra):
+    text = subprocess.run([mrf, "sweep", str(sweep), "--out", str(out), "--list", *extra], check=True,
+                          capture_output=True, text=True).stdout
+    return {f[1]: f[5] for f in (ln.split() for ln in text.strip().splitlines()[1:])}
+
+
 def close(a, b):
     return abs(a - b) <= 1e-2 * max(abs(a), abs(b))
 
@@ -68,8 +76,10 @@ for extra in ((), ("--archive", str(archive))):
     assert close(left, per[p1][0]), (left, per[p1][0])
     if not extra:  # a point finished in --out is its own estimate
         assert close(per[p0][0], s0["wall_seconds"]), (per[p0][0], s0["wall_seconds"])
-    else:  # read where it is: an estimate writes nothing into --out
+    else:  # read where it is: an estimate writes nothing into --out, nor does a list
         assert not out.exists(), "--estimate --archive restored the archive into --out"
+        assert list_states(*extra) == {p0: "archived", p1: "todo"}, list_states(*extra)
+        assert not out.exists(), "--list --archive restored the archive into --out"
     print(f"point 0 finished ({'archive' if extra else 'output'}): 1 of 2 to run, {left:.3g} s = point 1's estimate")
 
 # point 0 run again into --out, then a rule doubles its strain: stale
@@ -80,6 +90,7 @@ sweep.write_text(HEAD + '\n[[rule]]\nmason_max = 0.5\nset = ["drive.strain=0.4",
 per, left, n_run, n, total = estimate()
 assert (n_run, n) == (2, 2), (n_run, n)
 assert not per[p0][1], "a run for another scene does not count as finished"
+assert list_states()[p0] == "stale", list_states()
 want = s0["seconds_per_strain"] * 0.4
 assert close(per[p0][0], want), f"stale point 0 estimated {per[p0][0]} s, want its own {s0['seconds_per_strain']} s per strain x 0.4"
 print(f"rule changed point 0's strain: 2 of 2 to run, point 0 at its own rate x new strain ({per[p0][0]:.3g} s)")
