@@ -122,17 +122,18 @@ int sweep_command(const SweepArgs& a) {
                 "estimate (s; * = from the particle-steps model, no point of the model finished)");
     for (const auto& p : points) {
       const std::filesystem::path dir = std::filesystem::path(out) / p.dir;
-      const std::filesystem::path entry = std::filesystem::path(a.archive) / p.dir;
-      // an archived summary of this scene counts as finished (a run restores it)
-      const bool archived = !a.archive.empty() && std::filesystem::exists(entry / "summary.json") &&
-                            !mrf::point_stale(spec, p, entry);
-      const char* state = mrf::point_stale(spec, p, dir)                    ? "stale"
-                          : std::filesystem::exists(dir / "summary.json") ? "finished"
-                          : archived                                        ? "archived"
-                          : std::filesystem::exists(dir / "failure.json") ? "failed"
-                          : std::filesystem::exists(dir / "checkpoint.bin") ? "started"
-                          : !a.archive.empty() && std::filesystem::exists(entry / "summary.json") ? "stale"
-                                                                                            : "todo";
+      // as a run would find it: a folder for another scene is set aside and
+      // a current archive entry restored (the point then does not run)
+      const bool stale_here = mrf::point_stale(spec, p, dir);
+      const bool archived_entry =
+          !a.archive.empty() && std::filesystem::exists(std::filesystem::path(a.archive) / p.dir / "summary.json");
+      const char* state = !stale_here && std::filesystem::exists(dir / "summary.json") ? "finished"
+                          : mrf::archive_entry_current(spec, p, a.archive)              ? "archived"
+                          : stale_here                                                   ? "stale"
+                          : std::filesystem::exists(dir / "failure.json")               ? "failed"
+                          : std::filesystem::exists(dir / "checkpoint.bin")             ? "started"
+                          : archived_entry                                               ? "stale"
+                                                                                         : "todo";
       std::printf("%-5zu %-40s %-14s %-9g %-5llu %-9s %.3g%s\n", p.index, p.dir.c_str(), p.model.c_str(), p.mason,
                   static_cast<unsigned long long>(p.seed), state, est.seconds[p.index],
                   est.calibrated[p.index] ? "" : " *");
@@ -152,7 +153,7 @@ int sweep_command(const SweepArgs& a) {
         const std::filesystem::path dir = std::filesystem::path(root) / p.dir;
         return !root.empty() && std::filesystem::exists(dir / file) && !mrf::point_stale(spec, p, dir);
       };
-      const bool finished = has(out, "summary.json") || has(a.archive, "summary.json");
+      const bool finished = has(out, "summary.json") || mrf::archive_entry_current(spec, p, a.archive);
       const bool failed = !finished && has(out, "failure.json");
       std::printf("%-40s estimated %.3g s%s%s\n", p.dir.c_str(), e, est.calibrated[p.index] ? "" : " *",
                   finished ? " (finished)" : failed ? " (failed)" : "");

@@ -20,6 +20,7 @@ inline std::size_t block_bound(std::size_t n, std::size_t blk, std::size_t block
 inline std::size_t share_bound(const std::vector<std::uint32_t>& start, std::size_t blk, std::size_t blocks) {
   if (blk == 0 || start.empty()) return 0;
   if (blk >= blocks) return start.size() - 1;
+  if (start.back() == 0) return block_bound(start.size() - 1, blk, blocks);  // no work to share: equal blocks
   const auto target = static_cast<std::uint32_t>(static_cast<std::size_t>(start.back()) * blk / blocks);
   return static_cast<std::size_t>(std::lower_bound(start.begin(), start.end() - 1, target) - start.begin());
 }

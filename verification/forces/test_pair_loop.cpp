@@ -207,6 +207,21 @@ INSTANTIATE_TEST_SUITE_P(RandomShearCells, PairLoopMatchesLaws,
                          ::testing::Combine(::testing::Values(1, 2, 3), ::testing::Values(1e6, 0.0),
                                             ::testing::Values(1, 2)));
 
+// Two threads asked and a team of one given (OpenMP may give fewer threads
+// than asked: OMP_DYNAMIC, OMP_THREAD_LIMIT, a call inside another region):
+// the one thread takes every row, and the forces are the serial loop's.
+TEST(PairLoop, ATeamSmallerThanAskedGivesTheSerialForces) {
+  Case serial = random_case(4, 1e6), team_of_one = serial;
+  const PairSums a = run_loop(dem_pair_laws(serial.p), serial, 1);
+  const int levels = omp_get_max_active_levels();
+  omp_set_max_active_levels(0);  // every team of one thread
+  const PairSums b = run_loop(dem_pair_laws(team_of_one.p), team_of_one, 2);
+  omp_set_max_active_levels(levels);
+  EXPECT_EQ(serial.cell.free.f, team_of_one.cell.free.f);
+  EXPECT_EQ(a.virial_mag_xz, b.virial_mag_xz);
+  EXPECT_EQ(a.energy_hertz, b.energy_hertz);
+}
+
 // A dipole cut-off inside the contact distance (scene input refuses it; the
 // loop still tests every pair against it then).
 TEST(PairLoop, DipoleCutoffInsideContactDistance) {

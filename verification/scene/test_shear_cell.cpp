@@ -63,7 +63,7 @@ TEST(Placement, NumberedInSlabsAcrossTheGap) {
   }
 }
 
-TEST(Placement, RelabellingKeepsTheSameSeededSpheresWithoutOverlap) {
+TEST(Placement, ReproducibleAndWithoutOverlap) {
   const SceneConfig c = paper_like(3);
   const FreeParticles a = place_particles(c), b = place_particles(c);
   ASSERT_EQ(a.x, b.x);  // reproducible

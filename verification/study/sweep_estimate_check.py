@@ -91,6 +91,8 @@ per, left, n_run, n, total = estimate()
 assert (n_run, n) == (2, 2), (n_run, n)
 assert not per[p0][1], "a run for another scene does not count as finished"
 assert list_states()[p0] == "stale", list_states()
+shutil.rmtree(out)  # the archive's entry of point 0 is for the old strain: stale there too
+assert list_states("--archive", str(archive)) == {p0: "stale", p1: "todo"}, list_states("--archive", str(archive))
 want = s0["seconds_per_strain"] * 0.4
 assert close(per[p0][0], want), f"stale point 0 estimated {per[p0][0]} s, want its own {s0['seconds_per_strain']} s per strain x 0.4"
 print(f"rule changed point 0's strain: 2 of 2 to run, point 0 at its own rate x new strain ({per[p0][0]:.3g} s)")

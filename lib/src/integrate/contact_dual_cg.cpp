@@ -29,7 +29,6 @@ constexpr std::size_t k_dot_chunk = 256;  // contacts per partial sum of a dot p
 long ContactDual::solve_cg_jacobi(double rtol, long max_it) {
   const std::size_t m = act_.size(), ns = act_particles_.size();
   const std::size_t chunks = (m + k_dot_chunk - 1) / k_dot_chunk;
-  const int blocks = sphere_blocks_;  // > 1 only where index_spheres built the sphere entries
   PcgScratch<double>& s = cg_;
   d_.assign(m, 0.0);
   s.r = r_;
@@ -38,18 +37,19 @@ long ContactDual::solve_cg_jacobi(double rtol, long max_it) {
   s.q.resize(m);
   dot_part_.assign(3 * chunks, 0.0);
   long iterations = 0;
-#pragma omp parallel num_threads(blocks) if (blocks > 1)
+  // more than one thread only where index_spheres built the sphere entries
+#pragma omp parallel num_threads(sphere_blocks_) if (sphere_blocks_ > 1)
   {
-    const auto t = static_cast<std::size_t>(omp_get_thread_num()), nb = static_cast<std::size_t>(blocks);
+    // the team OpenMP gave (it may be smaller than asked): every share below
+    const auto t = static_cast<std::size_t>(omp_get_thread_num()),
+               nb = static_cast<std::size_t>(omp_get_num_threads());
     const std::size_t k0 = detail::block_bound(chunks, t, nb), k1 = detail::block_bound(chunks, t + 1, nb);
     const std::size_t s0 = detail::block_bound(ns, t, nb), s1 = detail::block_bound(ns, t + 1, nb);
     const std::size_t c0 = std::min(m, k0 * k_dot_chunk), c1 = std::min(m, k1 * k_dot_chunk);
-    // raw pointers: the loops below then need not reload the vectors' data
+    // raw pointers: the region's loops then need not reload the vectors' data
     double *const x = d_.data(), *const r = s.r.data(), *const z = s.z.data(), *const p = s.p.data(),
                   *const q = s.q.data(), *const part = dot_part_.data();
     const double* const diag = diag_.data();
-    const Packed* const packed = packed_.data();
-    Vec3* const pdisp = pdisp_.data();
     // this thread's chunks' partial sums of term(a) into slot `slot`
     const auto partial = [&](std::size_t slot, auto term) {
       for (std::size_t k = k0; k < k1; ++k) {
@@ -71,30 +71,13 @@ long ContactDual::solve_cg_jacobi(double rtol, long max_it) {
     const double stop2 = rtol * rtol * rr;  // r = b here
     long it = 0;
     while (rr > stop2 && it < max_it) {
-      // q = (A + C) p: M G p per sphere, then per contact n . (that of i - that of k) + compliance p
-      if (blocks == 1) {
-        for (auto i : act_particles_) pdisp[i].setZero();
-        for (std::size_t a = 0; a < m; ++a) {
-          const Packed& e = packed[a];
-          const Vec3 g = p[a] * e.n;
-          pdisp[e.i] += e.mob_i * g;
-          pdisp[e.k] -= e.mob_k * g;  // a wall pair: the spare row, 0 * g
-        }
+      if (nb == 1) {
+        packed_scatter(p);
       } else {
-        const std::vector<double>& mob = *mob_;
-        for (std::size_t u = s0; u < s1; ++u) {
-          const std::uint32_t i = act_particles_[u];
-          const double mi = mob[i];
-          Vec3 d = Vec3::Zero();
-          for (std::uint32_t e = row_start_[i]; e < row_start_[i + 1]; ++e) d += mi * (p[row_entry_[e].a] * row_entry_[e].sn);
-          pdisp[i] = d;
-        }
+        packed_gather(p, s0, s1);
 #pragma omp barrier
       }
-      for (std::size_t a = c0; a < c1; ++a) {
-        const Packed& e = packed[a];
-        q[a] = e.n.dot(pdisp[e.i] - pdisp[e.k]) + e.comp * p[a];
-      }
+      packed_product(p, q, c0, c1);
       partial(2, [&](std::size_t a) { return p[a] * q[a]; });
 #pragma omp barrier
       const double alpha = rz / total(2);

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
-#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -83,21 +82,17 @@ FreeParticles place_particles(const SceneConfig& c, const std::string& where_phi
     g.cells[(ix * g.ny + iy) * g.nz + iz].push_back(static_cast<std::uint32_t>(p.x.size()));
     p.x.push_back(q);
   }
-  // Numbered in slabs across the gap: by x cell, then y cell (both 2R
-  // wide), then z. Shear along z scrambles the z order over a strain unit,
-  // but x and y (gradient and vorticity) change only by rearrangement, so
-  // spheres near in the cell stay near in number: the threads' blocks of
-  // consecutive spheres (contact solve, pair lists) are slabs that share
-  // few contacts, and a sphere's neighbours sit close in memory.
-  std::vector<std::uint32_t> order(n);
-  for (std::uint32_t i = 0; i < n; ++i) order[i] = i;
-  const auto slab = [&](std::uint32_t i) {
-    const Vec3& q = p.x[i];
-    return std::make_tuple(g.cx(q.x()), static_cast<int>(q.y() / g.wy) % g.ny, q.z(), i);
-  };
-  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return slab(a) < slab(b); });
-  std::vector<Vec3> placed(n);
-  for (std::size_t i = 0; i < n; ++i) placed[i] = p.x[order[i]];
+  // Numbered in slabs across the gap: in the order of the insertion cells
+  // (x cell, then y cell, then z cell; each 2R or more wide). Shear along z
+  // scrambles the z order over a strain unit, but x and y (gradient and
+  // vorticity) change only by rearrangement, so spheres near in the cell
+  // stay near in number: the threads' blocks of consecutive spheres
+  // (contact solve, pair lists) are slabs that share few contacts, and a
+  // sphere's neighbours sit close in memory.
+  std::vector<Vec3> placed;
+  placed.reserve(n);
+  for (const auto& cell : g.cells)
+    for (std::uint32_t j : cell) placed.push_back(p.x[j]);
   p.x = std::move(placed);
   p.v.assign(n, Vec3::Zero());
   p.f.assign(n, Vec3::Zero());

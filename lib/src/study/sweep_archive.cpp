@@ -26,6 +26,14 @@ std::string read_text(const std::filesystem::path& p) {
 
 }  // namespace
 
+bool archive_entry_current(const SweepSpec& spec, const SweepPoint& p, const std::string& archive_dir) {
+  const auto entry = std::filesystem::path(archive_dir) / p.dir / "summary.json";
+  if (archive_dir.empty() || !std::filesystem::exists(entry)) return false;
+  const nlohmann::json j = nlohmann::json::parse(read_text(entry), nullptr, false);
+  return !j.is_discarded() && j.contains("scene_id") && j["scene_id"].is_string() &&
+         j["scene_id"].get<std::string>() == scene_id(load_scene(spec.scene_path, p.sets).config);
+}
+
 ArchiveSync restore_from_archive(const SweepSpec& spec, const std::vector<SweepPoint>& points,
                                  const std::string& out_dir, const std::string& archive_dir) {
   ArchiveSync sync;
@@ -44,14 +52,11 @@ ArchiveSync restore_from_archive(const SweepSpec& spec, const std::vector<SweepP
       }
       continue;
     }
-    const std::string text = read_text(entry);
-    const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
-    const std::string want = scene_id(load_scene(spec.scene_path, p.sets).config);
-    if (j.is_discarded() || !j.contains("scene_id") || !j["scene_id"].is_string() ||
-        j["scene_id"].get<std::string>() != want) {
+    if (!archive_entry_current(spec, p, archive_dir)) {
       sync.stale.push_back(p.dir);
       continue;
     }
+    const std::string text = read_text(entry);
     std::filesystem::create_directories(dir);
     std::filesystem::remove(dir / "checkpoint.bin");  // the point is finished: its partial run is moot
     write_file_atomic((dir / "summary.json").string(), text);

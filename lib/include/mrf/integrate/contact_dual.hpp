@@ -73,6 +73,12 @@ class ContactDual {
   // solve_cg without a coupled mobility and with Jacobi: the whole CG in one
   // parallel region (contact_dual_cg.cpp), d_ from zero
   long solve_cg_jacobi(double rtol, long max_it);
+  // apply's parts without a coupled mobility (packed_): M G p into pdisp_ by
+  // contacts, or for active spheres lo..hi by their entries; then
+  // out = (A + C) p for contacts lo..hi
+  void packed_scatter(const double* p);
+  void packed_gather(const double* p, std::size_t lo, std::size_t hi);
+  void packed_product(const double* p, double* out, std::size_t lo, std::size_t hi) const;
   // z = M^-1 r: IC(0) where solve_cg factored it, Jacobi otherwise
   void precondition(const std::vector<double>& r, std::vector<double>& z) const;
   // Once a solve has stalled (from its fourth iteration, the largest

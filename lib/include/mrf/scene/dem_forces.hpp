@@ -240,20 +240,24 @@ PairSums compute_pair_forces(const DemPairLaws<Dipole, Contact>& laws, const Box
   }
   buf.f.resize(static_cast<std::size_t>(nt));
   buf.sums.assign(static_cast<std::size_t>(nt), PairSums{});
+  int team = nt;
 #pragma omp parallel num_threads(nt)
   {
-    const int t = omp_get_thread_num();
+    // the team OpenMP gave (it may be smaller than asked) shares the rows
+    const int t = omp_get_thread_num(), nteam = omp_get_num_threads();
+    if (t == 0) team = nteam;
     auto& f = buf.f[static_cast<std::size_t>(t)];
     f.assign(n, Vec3::Zero());
-    detail::pair_share(laws, box, free, walls, lists, t, nt, f, buf.sums[static_cast<std::size_t>(t)]);
+    detail::pair_share(laws, box, free, walls, lists, t, nteam, f, buf.sums[static_cast<std::size_t>(t)]);
 #pragma omp barrier
 #pragma omp for schedule(static)
     for (std::size_t i = 0; i < n; ++i) {
       Vec3 sum = buf.f[0][i];
-      for (int u = 1; u < nt; ++u) sum += buf.f[static_cast<std::size_t>(u)][i];
+      for (int u = 1; u < nteam; ++u) sum += buf.f[static_cast<std::size_t>(u)][i];
       free.f[i] = sum;
     }
   }
+  buf.sums.resize(static_cast<std::size_t>(team));
   for (const PairSums& s : buf.sums) {  // thread order: deterministic
     const long pe = total.pair_evaluations;
     total.merge(s);

@@ -25,7 +25,8 @@ std::size_t particle_count(const SceneConfig& c);
 // Random sequential addition, seeded and reproducible on every platform:
 // centres uniform in y, z and in |x| <= gap/2 - 2R (clear of the wall
 // spheres), no two closer than 2R, numbered in slabs across the gap (by
-// x, then y, then z: an order that shear along z keeps). Throws InputError on
+// cells of 2R or more: x cell, then y cell, then z cell, an order that shear
+// along z keeps). Throws InputError on
 // particles.volume_fraction when the fraction cannot be packed.
 FreeParticles place_particles(const SceneConfig& c, const std::string& where_phi = {});
 

@@ -183,6 +183,10 @@ struct ArchiveSync {
 };
 ArchiveSync restore_from_archive(const SweepSpec& spec, const std::vector<SweepPoint>& points,
                                  const std::string& out_dir, const std::string& archive_dir);
+// Whether the archive holds a finished run of the point's scene as the
+// sweep file now defines it (a readable summary.json with its scene_id):
+// what a restore takes, --list calls archived and --estimate finished.
+bool archive_entry_current(const SweepSpec& spec, const SweepPoint& p, const std::string& archive_dir);
 // Copies a finished point's summary.json into the archive (atomically),
 // with its averaging window's series (window_series.csv, io/timeseries.hpp)
 // when the run wrote a time series; a point without a summary (failed,
