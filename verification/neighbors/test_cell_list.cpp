@@ -59,18 +59,16 @@ TEST_P(CellListVsBruteForce, PairRowsHoldTheSamePairs) {
   EXPECT_EQ(sorted(flat), sorted(brute_force_self_pairs(pts, box, rc)));
 }
 
-// Above the size where the build runs its rows on threads: the rows are
-// the serial build's, entry for entry, for 1, 2 and 3 threads, and hold the
-// brute-force pairs (blocks of uneven length and empty rows included).
-TEST_P(CellListVsBruteForce, PairRowsOnThreadsEqualTheSerialBuild) {
-  const auto [box, rc] = GetParam();
-  const auto pts = random_points(3001, box, 31);
+// The rows that build(rows) leaves, built on 1, 2 and 3 threads: the same
+// entry for entry, and the brute-force pairs of pts.
+template <class Build>
+void expect_serial_rows_on_threads(const std::vector<Vec3>& pts, const Box& box, double rc, Build build) {
   const int saved = omp_get_max_threads();
   std::vector<PairRows> by_threads;
   for (int t : {1, 2, 3}) {
     omp_set_num_threads(t);
     PairRows rows;
-    self_pair_rows(pts, box, rc, rows);
+    build(rows);
     by_threads.push_back(rows);
   }
   omp_set_num_threads(saved);
@@ -83,6 +81,15 @@ TEST_P(CellListVsBruteForce, PairRowsOnThreadsEqualTheSerialBuild) {
   for (std::uint32_t i = 0; i < pts.size(); ++i)
     for (std::uint32_t n = rows.start[i]; n < rows.start[i + 1]; ++n) flat.emplace_back(i, rows.k[n]);
   EXPECT_EQ(sorted(flat), sorted(brute_force_self_pairs(pts, box, rc)));
+}
+
+// Above the size where the build runs its rows on threads: the rows are
+// the serial build's, entry for entry, for 1, 2 and 3 threads, and hold the
+// brute-force pairs (blocks of uneven length and empty rows included).
+TEST_P(CellListVsBruteForce, PairRowsOnThreadsEqualTheSerialBuild) {
+  const auto [box, rc] = GetParam();
+  const auto pts = random_points(3001, box, 31);
+  expect_serial_rows_on_threads(pts, box, rc, [&](PairRows& rows) { self_pair_rows(pts, box, rc, rows); });
 }
 
 // A rebuild cuts its row blocks by the last list's shares (any numbering):
@@ -98,25 +105,10 @@ TEST_P(CellListVsBruteForce, RebuiltPairRowsOnThreadsEqualTheSerialBuild) {
     q += Vec3(u(rng), u(rng), u(rng));
     q.x() = std::clamp(q.x(), -box.gap / 2, box.gap / 2);
   }
-  const int saved = omp_get_max_threads();
-  std::vector<PairRows> by_threads;
-  for (int t : {1, 2, 3}) {
-    omp_set_num_threads(t);
-    PairRows rows;
+  expect_serial_rows_on_threads(moved, box, rc, [&](PairRows& rows) {
     self_pair_rows(pts, box, rc, rows);
     self_pair_rows(moved, box, rc, rows);
-    by_threads.push_back(rows);
-  }
-  omp_set_num_threads(saved);
-  for (std::size_t t = 1; t < by_threads.size(); ++t) {
-    EXPECT_EQ(by_threads[t].start, by_threads[0].start) << t + 1 << " threads";
-    EXPECT_EQ(by_threads[t].k, by_threads[0].k) << t + 1 << " threads";
-  }
-  std::vector<IndexPair> flat;
-  const PairRows& rows = by_threads[1];
-  for (std::uint32_t i = 0; i < moved.size(); ++i)
-    for (std::uint32_t n = rows.start[i]; n < rows.start[i + 1]; ++n) flat.emplace_back(i, rows.k[n]);
-  EXPECT_EQ(sorted(flat), sorted(brute_force_self_pairs(moved, box, rc)));
+  });
 }
 
 TEST_P(CellListVsBruteForce, CrossPairsIdentical) {
