@@ -64,21 +64,40 @@ void FluidResponse::set(std::size_t n_dem, const std::vector<CouplingPair>& pair
          i < detail::block_bound(n_dem, b + 1, static_cast<std::size_t>(blocks)); ++i)
       start_[i + 1] = static_cast<std::uint32_t>(start_[i + 1] + offset);
   }
-  rstart_.assign(na + 1, 0);
-  for (const std::uint32_t b : a_) ++rstart_[b + 1];
   // The same entries by SPH particle (CSR over a), so that the scatter is a
   // gather too: both passes run on threads without write conflicts, each
-  // sum in a fixed order.
-  for (std::size_t b = 0; b < na; ++b) rstart_[b + 1] += rstart_[b];
+  // sum in a fixed order. Built by the same blocks of DEM rows: each block
+  // counts its entries per SPH particle, the counts become each block's
+  // first free slot per SPH particle (block 0's entries first), and each
+  // block fills its own slots: every SPH particle's entries in ascending DEM
+  // order, as one pass over the rows would put them.
+  fill_.resize(static_cast<std::size_t>(blocks));
+  detail::for_blocks(n_dem, blocks, [&](std::size_t blk, std::size_t lo, std::size_t hi) {
+    std::vector<std::uint32_t>& count = fill_[blk];
+    count.assign(na, 0);
+    for (std::uint32_t e = start_[lo]; e < start_[hi]; ++e) ++count[a_[e]];
+  });
+  rstart_.assign(na + 1, 0);
+  for (std::size_t b = 0; b < na; ++b) {
+    std::uint32_t slot = rstart_[b];
+    for (std::vector<std::uint32_t>& count : fill_) {
+      const std::uint32_t n = count[b];
+      count[b] = slot;
+      slot += n;
+    }
+    rstart_[b + 1] = slot;
+  }
   rdem_.resize(a_.size());
   rscatter_.resize(a_.size());
-  fill_.assign(rstart_.begin(), rstart_.end() - 1);
-  for (std::size_t i = 0; i < n_dem; ++i)
-    for (std::uint32_t e = start_[i]; e < start_[i + 1]; ++e) {
-      const std::uint32_t slot = fill_[a_[e]]++;
-      rdem_[slot] = static_cast<std::uint32_t>(i);
-      rscatter_[slot] = scatter_[e];
-    }
+  detail::for_blocks(n_dem, blocks, [&](std::size_t blk, std::size_t lo, std::size_t hi) {
+    std::vector<std::uint32_t>& next = fill_[blk];
+    for (std::size_t i = lo; i < hi; ++i)
+      for (std::uint32_t e = start_[i]; e < start_[i + 1]; ++e) {
+        const std::uint32_t slot = next[a_[e]]++;
+        rdem_[slot] = static_cast<std::uint32_t>(i);
+        rscatter_[slot] = scatter_[e];
+      }
+  });
   // From here on both index lists hold offsets into xyz padded to four
   // doubles (4 x index): the gathers address x[4 col] without a shift.
   checked_index(4 * std::max(na, n_dem), "fluid response offset");

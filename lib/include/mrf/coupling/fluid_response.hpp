@@ -47,7 +47,7 @@ class FluidResponse final : public MobilityCoupling {
   std::vector<std::uint32_t> start_;  // pairs of DEM particle i: [start_[i], start_[i + 1])
   std::vector<std::uint32_t> rstart_, rdem_;  // the entries by SPH particle: 4 x DEM index
   std::vector<double> rscatter_;              // and scatter weight
-  std::vector<std::uint32_t> fill_;           // scratch of set(): the next free slot per SPH particle
+  std::vector<std::vector<std::uint32_t>> fill_;  // scratch of set(): per block of rows, its next free slot per SPH particle
   std::vector<std::vector<std::uint32_t>> part_a_;  // scratch of set(): the entries of each block of rows but the first
   std::vector<std::vector<double>> part_scatter_;
   // Threads only where there is work for them (a parallel region costs a
