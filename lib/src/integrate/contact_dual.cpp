@@ -40,29 +40,49 @@ struct Worst {
 // i, -n at k). A pass by sphere adds each sphere's terms in the order of the
 // serial pass over the contacts (m (q (-n)) = -(m (q n)) exactly), so the
 // result is the same bit for bit whatever the number of threads; on one
-// thread the pass over the contacts runs, which is faster there.
+// thread the pass over the contacts runs, which is faster there. Built by
+// blocks of contacts on threads: each block counts its entries per sphere,
+// the counts become each block's first slot per sphere (block 0's first),
+// and each block fills its own slots, so every sphere's entries come in
+// ascending a whatever the number of threads.
 void ContactDual::index_spheres(const std::vector<ContactPair>& pairs) {
-  const std::size_t n = disp_.size();
-  row_start_.assign(n + 1, 0);
-  for (auto c : act_) {
-    ++row_start_[pairs[c].i + 1];
-    if (!pairs[c].wall) ++row_start_[pairs[c].k + 1];
-  }
+  const std::size_t n = disp_.size(), m = act_.size();
+  const int blocks = detail::block_count(m, k_dual_per_thread);
+  row_fill_.resize(static_cast<std::size_t>(blocks));
+  detail::for_blocks(m, blocks, [&](std::size_t blk, std::size_t lo, std::size_t hi) {
+    std::vector<std::uint32_t>& count = row_fill_[blk];
+    count.assign(n, 0);
+    for (std::size_t a = lo; a < hi; ++a) {
+      const ContactPair& pc = pairs[act_[a]];
+      ++count[pc.i];
+      if (!pc.wall) ++count[pc.k];
+    }
+  });
+  row_start_.resize(n + 1);
+  row_start_[0] = 0;
   act_particles_.clear();
   for (std::uint32_t i = 0; i < n; ++i) {
-    if (row_start_[i + 1] > 0) act_particles_.push_back(i);
-    row_start_[i + 1] += row_start_[i];
+    std::uint32_t slot = row_start_[i];
+    for (std::vector<std::uint32_t>& count : row_fill_) {  // counts -> each block's first slot
+      const std::uint32_t c = count[i];
+      count[i] = slot;
+      slot += c;
+    }
+    if (slot > row_start_[i]) act_particles_.push_back(i);
+    row_start_[i + 1] = slot;
   }
   sphere_blocks_ = detail::block_count(act_particles_.size(), k_dual_per_thread);
   if (sphere_blocks_ == 1 && !uses_ic0()) return;
   row_entry_.resize(row_start_[n]);
-  row_fill_.assign(row_start_.begin(), row_start_.end() - 1);
-  for (std::uint32_t a = 0; a < act_.size(); ++a) {
-    const std::uint32_t c = act_[a];
-    const ContactPair& pc = pairs[c];
-    row_entry_[row_fill_[pc.i]++] = {n_[c], a};
-    if (!pc.wall) row_entry_[row_fill_[pc.k]++] = {-n_[c], a};
-  }
+  detail::for_blocks(m, blocks, [&](std::size_t blk, std::size_t lo, std::size_t hi) {
+    std::vector<std::uint32_t>& next = row_fill_[blk];
+    for (std::size_t a = lo; a < hi; ++a) {
+      const std::uint32_t c = act_[a];
+      const ContactPair& pc = pairs[c];
+      row_entry_[next[pc.i]++] = {n_[c], static_cast<std::uint32_t>(a)};
+      if (!pc.wall) row_entry_[next[pc.k]++] = {-n_[c], static_cast<std::uint32_t>(a)};
+    }
+  });
 }
 
 bool ContactDual::uses_ic0() const {

@@ -124,7 +124,8 @@ class ContactDual {
     std::uint32_t a;
   };
   std::vector<SphereEntry> row_entry_;
-  std::vector<std::uint32_t> row_start_, row_fill_;
+  std::vector<std::uint32_t> row_start_;
+  std::vector<std::vector<std::uint32_t>> row_fill_;  // index_spheres' scratch: per block of contacts, per sphere
   int sphere_blocks_ = 1;  // blocks of the passes over the spheres: 1, a pass over the contacts instead
   std::vector<double> d_, r_, diag_, dq_;           // CG on the active set: solution, right-hand side, Jacobi diagonal
   PcgScratch<double> cg_;
