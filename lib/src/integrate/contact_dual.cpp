@@ -137,38 +137,6 @@ void ContactDual::add_forces(const std::vector<ContactPair>& pairs, std::vector<
   }
 }
 
-// Without a coupled mobility, M G p from the packed pairs: by a pass over
-// the contacts (one thread), or for the active spheres lo..hi by their
-// entries (index_spheres), the same sums in the same order.
-void ContactDual::packed_scatter(const double* p) {
-  for (auto i : act_particles_) pdisp_[i].setZero();
-  for (std::size_t a = 0; a < packed_.size(); ++a) {
-    const Packed& e = packed_[a];
-    const Vec3 g = p[a] * e.n;
-    pdisp_[e.i] += e.mob_i * g;
-    pdisp_[e.k] -= e.mob_k * g;  // a wall pair: the spare row, 0 * g
-  }
-}
-
-void ContactDual::packed_gather(const double* p, std::size_t lo, std::size_t hi) {
-  const std::vector<double>& mob = *mob_;
-  for (std::size_t t = lo; t < hi; ++t) {
-    const std::uint32_t i = act_particles_[t];
-    const double mi = mob[i];
-    Vec3 d = Vec3::Zero();
-    for (std::uint32_t e = row_start_[i]; e < row_start_[i + 1]; ++e) d += mi * (p[row_entry_[e].a] * row_entry_[e].sn);
-    pdisp_[i] = d;
-  }
-}
-
-// out = n . (M G p at i - at k) + compliance p for the contacts lo..hi
-void ContactDual::packed_product(const double* p, double* out, std::size_t lo, std::size_t hi) const {
-  for (std::size_t a = lo; a < hi; ++a) {
-    const Packed& e = packed_[a];
-    out[a] = e.n.dot(pdisp_[e.i] - pdisp_[e.k]) + e.comp * p[a];  // a wall pair's k: the spare row, 0
-  }
-}
-
 // (A + C) p on the active set: A = G^T M G, C diagonal. Only the spheres of
 // active contacts are read back, so only their rows of M G p are formed.
 void ContactDual::apply(const std::vector<ContactPair>& pairs, const std::vector<double>& p,
