@@ -58,9 +58,20 @@ std::vector<std::size_t> in_blocks(std::size_t n, std::size_t per_thread, std::v
   for_blocks(
       n, blocks,
       [&](std::size_t b, std::size_t lo, std::size_t hi) {
-        std::vector<T>& mine = b == 0 ? out : part[b];
+        if (blocks == 1) {
+          out.clear();
+          body(lo, hi, out);
+          return;
+        }
+        // On threads each block fills a vector of its own (block 0 takes
+        // out's storage) and hands it back at the end: a push_back into out
+        // itself would write its header, next to data the other threads read
+        // in their loops, on every item.
+        std::vector<T> mine;
+        mine.swap(b == 0 ? out : part[b]);
         mine.clear();
         body(lo, hi, mine);
+        mine.swap(b == 0 ? out : part[b]);
       },
       bound);
   std::vector<std::size_t> begin(static_cast<std::size_t>(blocks), 0);
@@ -80,11 +91,15 @@ void in_blocks2(std::size_t n, std::size_t per_thread, std::vector<T>& out_t, st
   std::vector<std::vector<T>> part_t(static_cast<std::size_t>(blocks));
   std::vector<std::vector<U>> part_u(static_cast<std::size_t>(blocks));
   for_blocks(n, blocks, [&](std::size_t b, std::size_t lo, std::size_t hi) {
-    std::vector<T>& mt = b == 0 ? out_t : part_t[b];
-    std::vector<U>& mu = b == 0 ? out_u : part_u[b];
+    std::vector<T> mt;  // the block's own vectors, as in in_blocks
+    std::vector<U> mu;
+    mt.swap(b == 0 ? out_t : part_t[b]);
+    mu.swap(b == 0 ? out_u : part_u[b]);
     mt.clear();
     mu.clear();
     body(lo, hi, mt, mu);
+    mt.swap(b == 0 ? out_t : part_t[b]);
+    mu.swap(b == 0 ? out_u : part_u[b]);
   });
   for (std::size_t blk = 1; blk < static_cast<std::size_t>(blocks); ++blk) {
     out_t.insert(out_t.end(), part_t[blk].begin(), part_t[blk].end());

@@ -328,9 +328,12 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
     // blocks of pairs, each listing its active pairs, joined in order.
     worst_of.assign(static_cast<std::size_t>(pair_blocks), Worst{});
     detail::for_blocks(np, pair_blocks, [&](std::size_t blk, std::size_t lo, std::size_t hi) {
-      std::vector<std::uint32_t>& mine = blk == 0 ? act_ : act_part_[blk];
+      // the block's own list and maximum, handed back at the end (as in
+      // detail::in_blocks: act_'s header is next to the members read here)
+      std::vector<std::uint32_t> mine;
+      mine.swap(blk == 0 ? act_ : act_part_[blk]);
       mine.clear();
-      Worst& w = worst_of[blk];
+      Worst w;
       for (std::size_t c = lo; c < hi; ++c) {
         const ContactPair& pc = pairs[c];
         const Vec3 r = pair_vector(pc, y, walls, mi);
@@ -347,6 +350,8 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
         mine.push_back(static_cast<std::uint32_t>(c));
         w.see(phi, pc.i);
       }
+      mine.swap(blk == 0 ? act_ : act_part_[blk]);
+      worst_of[blk] = w;
     });
     for (int blk = 1; blk < pair_blocks; ++blk)
       act_.insert(act_.end(), act_part_[static_cast<std::size_t>(blk)].begin(),
