@@ -45,6 +45,56 @@ void for_blocks(std::size_t n, int blocks, Body&& body, Bound bound = &block_bou
   }
 }
 
+// body(i) for each i of [0, n), on threads when n >= per_thread: for a body
+// that writes only item i, the result of the serial loop.
+template <class Body>
+void for_each_index(std::size_t n, std::size_t per_thread, Body&& body) {
+  for_blocks(n, block_count(n, per_thread), [&](std::size_t, std::size_t lo, std::size_t hi) {
+    for (std::size_t i = lo; i < hi; ++i) body(i);
+  });
+}
+
+// dst = src, in equal blocks on threads when src.size() >= per_thread.
+template <class T>
+void copy_on_threads(const std::vector<T>& src, std::vector<T>& dst, std::size_t per_thread) {
+  const int blocks = block_count(src.size(), per_thread);
+  if (blocks == 1) {
+    dst = src;
+    return;
+  }
+  dst.resize(src.size());
+  for_blocks(src.size(), blocks, [&](std::size_t, std::size_t lo, std::size_t hi) {
+    std::copy(src.begin() + static_cast<std::ptrdiff_t>(lo), src.begin() + static_cast<std::ptrdiff_t>(hi),
+              dst.begin() + static_cast<std::ptrdiff_t>(lo));
+  });
+}
+
+// The largest of value(i) over [0, n) and the first i where it is taken
+// (strictly larger than everything before it, as a serial pass keeps it;
+// at = n when nothing exceeds `floor`), on threads when n >= per_thread;
+// the blocks' results merged in order, so the same whatever the threads.
+struct Largest {
+  double v;
+  std::size_t at;
+};
+template <class Value>
+Largest largest_of(std::size_t n, std::size_t per_thread, double floor, Value&& value) {
+  const int blocks = block_count(n, per_thread);
+  std::vector<Largest> part(static_cast<std::size_t>(blocks), Largest{floor, n});
+  for_blocks(n, blocks, [&](std::size_t b, std::size_t lo, std::size_t hi) {
+    Largest best{floor, n};  // a local, stored once: the blocks' slots share a cache line
+    for (std::size_t i = lo; i < hi; ++i) {
+      const double v = value(i);
+      if (v > best.v) best = {v, i};
+    }
+    part[b] = best;
+  });
+  Largest best{floor, n};
+  for (const Largest& p : part)
+    if (p.v > best.v) best = p;
+  return best;
+}
+
 // body(lo, hi, mine) over [0, n) in contiguous blocks, one per thread when
 // n >= per_thread, each filling its own list; the lists are joined into
 // `out` in block order, so the result is the same whatever the number of

@@ -26,10 +26,16 @@ void FluidResponse::set(std::size_t n_dem, const std::vector<CouplingPair>& pair
   part_scatter_.resize(static_cast<std::size_t>(blocks));
   std::vector<char> unsorted(static_cast<std::size_t>(blocks), 0);
   detail::for_blocks(n_dem, blocks, [&](std::size_t blk, std::size_t lo, std::size_t hi) {
-    std::vector<std::uint32_t>& a = blk == 0 ? a_ : part_a_[blk];
-    std::vector<double>& sc_of = blk == 0 ? scatter_ : part_scatter_[blk];
+    // the block's own lists, handed back at the end: a push_back into a_
+    // would write its header next to the members the other threads read
+    // (false sharing; docs/performance.md, session 29)
+    std::vector<std::uint32_t> a;
+    std::vector<double> sc_of;
+    a.swap(blk == 0 ? a_ : part_a_[blk]);
+    sc_of.swap(blk == 0 ? scatter_ : part_scatter_[blk]);
     a.clear();
     sc_of.clear();
+    bool unordered = false;
     std::size_t next = static_cast<std::size_t>(
         std::lower_bound(pairs.begin(), pairs.end(), lo, [](const CouplingPair& q, std::size_t i) { return q.i < i; }) -
         pairs.begin());
@@ -41,7 +47,7 @@ void FluidResponse::set(std::size_t n_dem, const std::vector<CouplingPair>& pair
         if (a.size() > row && a.back() == q.a) {
           sc_of.back() += sc;
         } else {
-          if (a.size() > row && a.back() > q.a) unsorted[blk] = 1;
+          if (a.size() > row && a.back() > q.a) unordered = true;
           a.push_back(q.a);
           sc_of.push_back(sc);
         }
@@ -49,6 +55,9 @@ void FluidResponse::set(std::size_t n_dem, const std::vector<CouplingPair>& pair
       start_[i + 1] = static_cast<std::uint32_t>(a.size());  // checked below, with the joined size
       for (std::size_t e = row; e < a.size(); ++e) diag_[i] += mass * sc_of[e] * sc_of[e];
     }
+    a.swap(blk == 0 ? a_ : part_a_[blk]);
+    sc_of.swap(blk == 0 ? scatter_ : part_scatter_[blk]);
+    unsorted[blk] = unordered ? 1 : 0;
   });
   if (std::find(unsorted.begin(), unsorted.end(), 1) != unsorted.end())
     throw std::logic_error("FluidResponse::set: pairs not sorted by (i, a)");

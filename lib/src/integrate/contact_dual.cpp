@@ -293,11 +293,12 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
   // Every pair with a force is active in the passes below (an active set
   // holds every pair with lambda > 0), so a move by the active set's forces
   // is a move by all of them.
-  act_.clear();
-  for (std::size_t c = 0; c < np; ++c)
-    if (lambda_[c] > 0) act_.push_back(static_cast<std::uint32_t>(c));
+  detail::in_blocks(np, k_dual_per_thread, act_, [&](std::size_t lo, std::size_t hi, std::vector<std::uint32_t>& mine) {
+    for (std::size_t c = lo; c < hi; ++c)
+      if (lambda_[c] > 0) mine.push_back(static_cast<std::uint32_t>(c));
+  });
   index_spheres(pairs);
-  y = b;
+  detail::copy_on_threads(b, y, k_dual_per_thread);
   move(pairs, lambda_, true, y);
   const double inv_k23 = 1.0 / std::cbrt(hertz_k * hertz_k);  // k^{-2/3}
   // lambda += t d on the active set (projected on lambda >= 0), y moved by
@@ -362,7 +363,7 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
     };
     for (const Worst& w : worst_of) merge(w);
     index_spheres(pairs);
-    y_next_ = b;
+    detail::copy_on_threads(b, y_next_, k_dual_per_thread);
     move(pairs, lambda_, true, y_next_);
     // y was placed with the normals of the last iterate; with the normals
     // just updated, y - y_next = r_y. Newton on (y, lambda) with r_y
@@ -373,14 +374,16 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
     const int act_blocks = detail::block_count(m, k_dual_per_thread);
     worst_of.assign(static_cast<std::size_t>(act_blocks), Worst{});
     detail::for_blocks(m, act_blocks, [&](std::size_t blk, std::size_t lo, std::size_t hi) {
+      Worst w;  // stored at the end: the blocks' slots share a cache line
       for (std::size_t a = lo; a < hi; ++a) {
         const std::uint32_t c = act_[a];
         const ContactPair& pc = pairs[c];
         const Vec3 ry = pc.wall ? Vec3(y[pc.i] - y_next_[pc.i])
                                 : Vec3((y[pc.i] - y_next_[pc.i]) - (y[pc.k] - y_next_[pc.k]));
         rhs_[c] += n_[c].dot(ry);
-        worst_of[blk].see(rhs_[c], pc.i);
+        w.see(rhs_[c], pc.i);
       }
+      worst_of[blk] = w;
     });
     for (const Worst& w : worst_of) merge(w);
     // Backtracking: an update that more than doubled the largest residual
@@ -392,8 +395,8 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
     // model 3: periods of 2 and 3 iterations until the 20 allowed ran out).
     if (res.iterations > 1 && worst > opt.tol && worst > 2.0 * prev_worst && theta > 0.2) {
       theta *= 0.5;
-      lambda_ = lambda_prev_;
-      y = y_prev_;
+      detail::copy_on_threads(lambda_prev_, lambda_, k_dual_per_thread);
+      detail::copy_on_threads(y_prev_, y, k_dual_per_thread);
       n_.swap(n_prev_);
       act_.swap(act_prev_);
       index_spheres(pairs);  // of the previous active set (the next iteration indexes its own)
@@ -416,9 +419,9 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
     worst_1 = worst;
     if (stalled) res.linear_iterations += resolve_clipped(pairs, opt.linear_rtol);
     y.swap(y_next_);
-    lambda_prev_ = lambda_;  // for a backtrack
-    y_prev_ = y;
-    n_prev_ = n_;
+    detail::copy_on_threads(lambda_, lambda_prev_, k_dual_per_thread);  // for a backtrack
+    detail::copy_on_threads(y, y_prev_, k_dual_per_thread);
+    detail::copy_on_threads(n_, n_prev_, k_dual_per_thread);
     act_prev_ = act_;
     d_prev_ = d_;
     update(1.0, d_, y);

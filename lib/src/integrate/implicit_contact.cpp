@@ -75,8 +75,20 @@ void contact_candidates(const std::vector<ContactPair>& ff_near, const std::vect
                         if (box.min_image(x[c.i] - x[c.k]).squaredNorm() < reach2) mine.push_back(c);
                       }
                     });
-  for (const auto& [i, k] : fw)
-    if (box.min_image(x[i] - walls.x[k]).squaredNorm() < reach2) out.push_back({i, k, true});
+  if (detail::block_count(fw.size(), k_candidate_pairs_per_thread) == 1) {
+    for (const auto& [i, k] : fw)
+      if (box.min_image(x[i] - walls.x[k]).squaredNorm() < reach2) out.push_back({i, k, true});
+    return;
+  }
+  thread_local std::vector<ContactPair> wall;  // the free-wall candidates, by blocks in order
+  detail::in_blocks(fw.size(), k_candidate_pairs_per_thread, wall,
+                    [&](std::size_t lo, std::size_t hi, std::vector<ContactPair>& mine) {
+                      for (std::size_t n = lo; n < hi; ++n) {
+                        const auto [i, k] = fw[n];
+                        if (box.min_image(x[i] - walls.x[k]).squaredNorm() < reach2) mine.push_back({i, k, true});
+                      }
+                    });
+  out.insert(out.end(), wall.begin(), wall.end());
 }
 
 namespace {
@@ -93,14 +105,41 @@ double contact_forces(const std::vector<ContactPair>& pairs, const std::vector<V
                       std::vector<Vec3>& f) {
   f.assign(x.size(), Vec3::Zero());
   double h_max = 0;
-  for (const ContactPair& c : pairs) {
-    const Vec3 r_ik = separation(c, x, walls, box);
-    const double r = r_ik.norm(), h = 2.0 * radius - r;
-    if (h <= 0) continue;
-    const Vec3 fc = (hertz_force(h, hertz_k) / r) * r_ik;  // Hertz, REFERENCE.md Eq. 2
-    f[c.i] += fc;
-    if (!c.wall) f[c.k] -= fc;
-    h_max = std::max(h_max, h);
+  if (detail::block_count(pairs.size(), k_candidate_pairs_per_thread) == 1) {
+    for (const ContactPair& c : pairs) {
+      const Vec3 r_ik = separation(c, x, walls, box);
+      const double r = r_ik.norm(), h = 2.0 * radius - r;
+      if (h <= 0) continue;
+      const Vec3 fc = (hertz_force(h, hertz_k) / r) * r_ik;  // Hertz, REFERENCE.md Eq. 2
+      f[c.i] += fc;
+      if (!c.wall) f[c.k] -= fc;
+      h_max = std::max(h_max, h);
+    }
+    return h_max;
+  }
+  // On threads: the pairs' forces by blocks (most candidates are open), then
+  // added in the order of the pairs: the serial sums.
+  struct Push {
+    Vec3 fc;
+    double h;
+    std::uint32_t c;
+  };
+  thread_local std::vector<Push> pushes;  // kept: a list this long is otherwise mapped anew at every call
+  detail::in_blocks(pairs.size(), k_candidate_pairs_per_thread, pushes,
+                    [&](std::size_t lo, std::size_t hi, std::vector<Push>& mine) {
+                      for (std::size_t c = lo; c < hi; ++c) {
+                        const Vec3 r_ik = separation(pairs[c], x, walls, box);
+                        const double r = r_ik.norm(), h = 2.0 * radius - r;
+                        if (h <= 0) continue;
+                        // Hertz, REFERENCE.md Eq. 2
+                        mine.push_back({(hertz_force(h, hertz_k) / r) * r_ik, h, static_cast<std::uint32_t>(c)});
+                      }
+                    });
+  for (const Push& p : pushes) {
+    const ContactPair& c = pairs[p.c];
+    f[c.i] += p.fc;
+    if (!c.wall) f[c.k] -= p.fc;
+    h_max = std::max(h_max, p.h);
   }
   return h_max;
 }

@@ -8,6 +8,7 @@
 #include "mrf/error.hpp"
 #include "mrf/integrate/stability.hpp"
 #include "mrf/integrate/steps.hpp"
+#include "parallel_blocks.hpp"
 
 namespace mrf {
 
@@ -26,6 +27,9 @@ constexpr double k_max_growth = 2.0;
 constexpr double k_newton_cap_after_failure = 0.8, k_newton_cap_relax = 1.02;
 // A step shorter than this fraction of the largest allowed one is a failure.
 constexpr double k_dt_floor = 1e-7;
+// Spheres a thread takes at least in the step's passes over them (each
+// sphere's own arithmetic: the same results on any number of threads).
+constexpr std::size_t k_spheres_per_thread = 1024;
 
 // x moved to the periodic image nearest `ref` (positions are wrapped each step).
 Vec3 image_near(const Vec3& ref, const Vec3& x, const Box& box) { return ref - box.min_image(ref - x); }
@@ -65,7 +69,7 @@ ImplicitStepper::Attempt ImplicitStepper::attempt(double dt, const ImplicitDrift
   b_.resize(n);
   mob_.resize(n);
   if (carried) carrier_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
+  detail::for_each_index(n, k_spheres_per_thread, [&](std::size_t i) {
     mob_[i] = c * dt * d.inv_gamma[i];
     const Vec3 w = bdf2 ? Vec3((1 + om) * d.w0[i] - om * w_prev_[i]) : d.w0[i];
     if (carried) {
@@ -74,12 +78,12 @@ ImplicitStepper::Attempt ImplicitStepper::attempt(double dt, const ImplicitDrift
       b_[i] = bdf2 ? Vec3(a1 * x0_[i] - a2 * (image_near(x0_[i], x_prev_[i], box) + carrier_prev_[i]) + carrier_[i] +
                           c * dt * w)
                    : Vec3(x0_[i] + carrier_[i] + dt * w);
-      continue;
+      return;
     }
     const Vec3 drift = accelerating ? Vec3(w + dt * d.w1[i]) : w;
     b_[i] = bdf2 ? Vec3(a1 * x0_[i] - a2 * image_near(x0_[i], x_prev_[i], box) + c * dt * drift)
                  : Vec3(x0_[i] + dt * drift);
-  }
+  });
   // the fluid's response to the contact forces: over the whole step at its
   // end (c dt dt), or along the carrier's path (dt^2 / 2)
   const double response_scale = carried ? 0.5 * dt * dt : c * dt * dt;
@@ -124,26 +128,29 @@ ImplicitStepper::Attempt ImplicitStepper::attempt(double dt, const ImplicitDrift
   }
   // Positions relative to the carrier's position X at t_n: x_n itself,
   // x_{n-1} + D_{n-1}, x_{n-2} + D_{n-1} + D_{n-2}, and x - D_n at t_{n+1}.
+  // The error and the largest step off the imposed flow, each sphere's own.
   const Vec3 zero = Vec3::Zero();
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3& dn = carried ? carrier_[i] : zero;
-    const Vec3& d1 = carried && history_ >= 1 ? carrier_prev_[i] : zero;
-    const Vec3& d2 = carried && history_ >= 2 ? carrier_prev2_[i] : zero;
-    if (quadratic) {
-      const Vec3 pred = l0 * (image_near(x0_[i], x_prev2_[i], box) + d1 + d2) +
-                        l1 * (image_near(x0_[i], x_prev_[i], box) + d1) + l2 * x0_[i];
-      a.error = std::max(a.error, k_bdf2_error_constant * (f.x[i] - dn - pred).norm());
-    } else {
-      // the last step's mean velocity relative to its carrier (at the first
-      // step, relative to the carrier now)
-      const Vec3 v_rel = !carried ? f.v[i] : history_ >= 1 ? Vec3(f.v[i] - d1 / dt_) : Vec3(f.v[i] - d.u[i]);
-      a.error = std::max(a.error, 0.5 * (f.x[i] - x0_[i] - dn - dt * v_rel).norm());
-    }
+  a.error = detail::largest_of(n, k_spheres_per_thread, 0.0, [&](std::size_t i) {
+              const Vec3& dn = carried ? carrier_[i] : zero;
+              const Vec3& d1 = carried && history_ >= 1 ? carrier_prev_[i] : zero;
+              const Vec3& d2 = carried && history_ >= 2 ? carrier_prev2_[i] : zero;
+              if (quadratic) {
+                const Vec3 pred = l0 * (image_near(x0_[i], x_prev2_[i], box) + d1 + d2) +
+                                  l1 * (image_near(x0_[i], x_prev_[i], box) + d1) + l2 * x0_[i];
+                return k_bdf2_error_constant * (f.x[i] - dn - pred).norm();
+              }
+              // the last step's mean velocity relative to its carrier (at the
+              // first step, relative to the carrier now)
+              const Vec3 v_rel = !carried ? f.v[i] : history_ >= 1 ? Vec3(f.v[i] - d1 / dt_) : Vec3(f.v[i] - d.u[i]);
+              return 0.5 * (f.x[i] - x0_[i] - dn - dt * v_rel).norm();
+            }).v;
+  const detail::Largest moved = detail::largest_of(n, k_spheres_per_thread, 0.0, [&](std::size_t i) {
     Vec3 step = f.x[i] - x0_[i];
     step.z() -= p_.shear_rate * dt * x0_[i].x();  // less the affine part (the candidates' bound)
-    const double disp = step.norm();
-    if (disp > a.displacement) a.displacement = disp, a.moved = static_cast<std::uint32_t>(i);
-  }
+    return step.norm();
+  });
+  a.displacement = moved.v;
+  if (moved.at < n) a.moved = static_cast<std::uint32_t>(moved.at);
   return a;
 }
 
@@ -178,7 +185,7 @@ double ImplicitStepper::advance(const ImplicitDrift& d, FreeParticles& f, WallPa
       throw NumericalError(m.str());
     }
     if (a.newton.converged && !too_far && (ratio <= 1.0 || opt_.fixed_step)) {
-      for (std::size_t i = 0; i < f.size(); ++i) f.v[i] = (f.x[i] - x0_[i]) / dt;
+      detail::for_each_index(f.size(), k_spheres_per_thread, [&](std::size_t i) { f.v[i] = (f.x[i] - x0_[i]) / dt; });
       // No growth right after a rejection (Hairer & Wanner's rule: the step
       // that just failed is a better guess than the error model), nor after
       // a Newton solve that took more than half its iterations (a longer

@@ -145,12 +145,14 @@ std::vector<IndexPair> cross_pairs(const std::vector<Vec3>& a, const std::vector
   grid.bin(b);
   const double rc2 = cutoff * cutoff;
   const MinImageYZ mi(box);
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    grid.for_each_candidate(a[i], [&](std::uint32_t j) {
-      if (mi.norm2(a[i], b[j]) < rc2)
-        out.emplace_back(static_cast<std::uint32_t>(i), j);
-    });
-  }
+  // by blocks of a's points on threads, joined in order: the serial list
+  constexpr std::size_t k_points_per_thread = 1024;
+  detail::in_blocks(a.size(), k_points_per_thread, out, [&](std::size_t i0, std::size_t i1, std::vector<IndexPair>& mine) {
+    for (std::size_t i = i0; i < i1; ++i)
+      grid.for_each_candidate(a[i], [&](std::uint32_t j) {
+        if (mi.norm2(a[i], b[j]) < rc2) mine.emplace_back(static_cast<std::uint32_t>(i), j);
+      });
+  });
   return out;
 }
 

@@ -3,25 +3,28 @@
 #include <algorithm>
 #include <cmath>
 
+#include "parallel_blocks.hpp"
+
 namespace mrf {
+
+namespace {
+constexpr std::size_t k_spheres_per_thread = 2048;  // of the displacement passes
+}
 
 double max_displacement(const std::vector<Vec3>& x, const std::vector<Vec3>& ref, const Box& box) {
   const MinImageYZ mi(box);
-  double max2 = 0;
-  for (std::size_t i = 0; i < x.size(); ++i) max2 = std::max(max2, mi.norm2(x[i], ref[i]));
-  return std::sqrt(max2);
+  return std::sqrt(
+      detail::largest_of(x.size(), k_spheres_per_thread, 0.0, [&](std::size_t i) { return mi.norm2(x[i], ref[i]); }).v);
 }
 
 double max_nonaffine_displacement(const std::vector<Vec3>& x, const std::vector<Vec3>& ref, const Box& box,
                                   double strain) {
   const MinImageYZ mi(box);
-  double max2 = 0;
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    Vec3 d = mi.delta(x[i], ref[i]);
-    d.z() -= strain * ref[i].x();
-    max2 = std::max(max2, d.squaredNorm());
-  }
-  return std::sqrt(max2);
+  return std::sqrt(detail::largest_of(x.size(), k_spheres_per_thread, 0.0, [&](std::size_t i) {
+                     Vec3 d = mi.delta(x[i], ref[i]);
+                     d.z() -= strain * ref[i].x();
+                     return d.squaredNorm();
+                   }).v);
 }
 
 double choose_skin(const SkinPolicy& policy, double range, double nonaffine_per_step, double strain_per_step) {
