@@ -103,14 +103,21 @@ Vec3 separation(const ContactPair& c, const std::vector<Vec3>& x, const WallPart
 double contact_forces(const std::vector<ContactPair>& pairs, const std::vector<Vec3>& x,
                       const WallParticles& walls, const Box& box, double radius, double hertz_k,
                       std::vector<Vec3>& f) {
+  // the overlap of pair c at x and, where it is positive, its Hertz force
+  // on i (REFERENCE.md Eq. 2)
+  const auto hertz_of = [&](const ContactPair& c, Vec3& fc) {
+    const Vec3 r_ik = separation(c, x, walls, box);
+    const double r = r_ik.norm(), h = 2.0 * radius - r;
+    if (h > 0) fc = (hertz_force(h, hertz_k) / r) * r_ik;
+    return h;
+  };
   f.assign(x.size(), Vec3::Zero());
   double h_max = 0;
   if (detail::block_count(pairs.size(), k_candidate_pairs_per_thread) == 1) {
+    Vec3 fc;
     for (const ContactPair& c : pairs) {
-      const Vec3 r_ik = separation(c, x, walls, box);
-      const double r = r_ik.norm(), h = 2.0 * radius - r;
+      const double h = hertz_of(c, fc);
       if (h <= 0) continue;
-      const Vec3 fc = (hertz_force(h, hertz_k) / r) * r_ik;  // Hertz, REFERENCE.md Eq. 2
       f[c.i] += fc;
       if (!c.wall) f[c.k] -= fc;
       h_max = std::max(h_max, h);
@@ -127,12 +134,10 @@ double contact_forces(const std::vector<ContactPair>& pairs, const std::vector<V
   thread_local std::vector<Push> pushes;  // kept: a list this long is otherwise mapped anew at every call
   detail::in_blocks(pairs.size(), k_candidate_pairs_per_thread, pushes,
                     [&](std::size_t lo, std::size_t hi, std::vector<Push>& mine) {
+                      Vec3 fc;
                       for (std::size_t c = lo; c < hi; ++c) {
-                        const Vec3 r_ik = separation(pairs[c], x, walls, box);
-                        const double r = r_ik.norm(), h = 2.0 * radius - r;
-                        if (h <= 0) continue;
-                        // Hertz, REFERENCE.md Eq. 2
-                        mine.push_back({(hertz_force(h, hertz_k) / r) * r_ik, h, static_cast<std::uint32_t>(c)});
+                        const double h = hertz_of(pairs[c], fc);
+                        if (h > 0) mine.push_back({fc, h, static_cast<std::uint32_t>(c)});
                       }
                     });
   for (const Push& p : pushes) {
