@@ -112,7 +112,8 @@ TEST(FluidResponse, RowsGiveTheRowsOfTheFullProduct) {
 
 // set() builds the entries by blocks of DEM rows on threads, joined in
 // order: on 1, 2 and 3 threads the diagonal, the couplings and the product
-// are the same bit for bit (above the block threshold of 8192 pairs).
+// (all rows, and some) are the same bit for bit (above the block threshold
+// of 8192 pairs).
 TEST(FluidResponse, TheSameOnAnyNumberOfThreads) {
   Coupled u = make_setup(1500, 11);
   ASSERT_GT(u.pairs.size(), 3u * 8192u);
@@ -123,8 +124,12 @@ TEST(FluidResponse, TheSameOnAnyNumberOfThreads) {
     omp_set_num_threads(t);
     FluidResponse r;
     r.set(u.dem.size(), u.pairs, u.s, u.rho, u.mass);
-    std::vector<Vec3> y(u.dem.size(), Vec3::Zero());
+    std::vector<Vec3> y(u.dem.size(), Vec3::Zero()), some(u.dem.size(), Vec3::Zero());
     r.add(f, 1.0, y);
+    std::vector<std::uint32_t> rows;
+    for (std::uint32_t i = 0; i < u.dem.size(); i += 3) rows.push_back(i);
+    r.add(f, 0.5, some, &rows);
+    y.insert(y.end(), some.begin(), some.end());
     std::vector<double> d;
     for (std::size_t i = 0; i < u.dem.size(); ++i) d.push_back(r.diagonal(i));
     for (std::size_t i = 0; i + 1 < u.dem.size(); i += 7) d.push_back(r.coupling(i, i + 1));

@@ -8,6 +8,7 @@
 #include "mrf/fluid/viscosity.hpp"
 #include "mrf/integrate/pcg.hpp"
 
+#include "parallel_blocks.hpp"
 #include "runs.hpp"
 
 namespace mrf {
@@ -20,6 +21,10 @@ template <class Rows, class Run>
 void by_rows(const Rows& rows, Run run) {
   detail::for_each_run(rows, [](const auto& e) { return e.a; }, run);
 }
+
+// Below this many pairs the products run serially (a product of the paper
+// cell's 900 SPH particles has about 33k).
+constexpr std::size_t k_rows_per_thread = 4096;
 }  // namespace
 
 const char* to_string(SphImplicit s) {
@@ -52,9 +57,32 @@ ImplicitFluidSystem::ImplicitFluidSystem(const FluidCell& c, double dt, SphImpli
   }
   diag_.resize(n);
   for (std::size_t a = 0; a < n; ++a) diag_[a] = Vec3::Constant(vdiag_[a]);
+  // On threads the products gather: per particle a copy of each row it is
+  // an end of, in row order, seen from its side (the other end; g_ab
+  // signed, so that g . (x_a - x_other) is the row's g . (x_a - x_b) for
+  // either end): each particle's sum takes its terms in the order the
+  // serial scatter adds them, the same result bit for bit.
+  if (detail::block_count(rows_.size(), k_rows_per_thread) > 1) {
+    inc_start_.assign(n + 1, 0);
+    for (const Row& e : rows_) ++inc_start_[e.a + 1], ++inc_start_[e.b + 1];
+    for (std::size_t a = 0; a < n; ++a) inc_start_[a + 1] += inc_start_[a];
+    inc_.resize(inc_start_[n]);
+    std::vector<std::uint32_t> next(inc_start_.begin(), inc_start_.end() - 1);
+    for (const Row& e : rows_) {
+      inc_[next[e.a]++] = {e.a, e.b, e.k, Vec3::Zero()};
+      inc_[next[e.b]++] = {e.b, e.a, e.k, Vec3::Zero()};
+    }
+  }
   if (!pressure_) return;
   const double scale = c.mass * c.density_scale;
   for (std::size_t e = 0; e < pairs.size(); ++e) rows_[e].g = scale * kernel_dwdr_over_r(pairs[e].r, c.h) * pairs[e].r_ab;
+  if (!inc_.empty()) {
+    std::vector<std::uint32_t> next(inc_start_.begin(), inc_start_.end() - 1);
+    for (const Row& e : rows_) {
+      inc_[next[e.a]++].g = e.g;
+      inc_[next[e.b]++].g = -e.g;
+    }
+  }
   tw_.assign(n, Vec3::Zero());
   d0_.assign(n, 0.0);
   for (const SphPair& pr : wall_pairs) {
@@ -109,6 +137,15 @@ void ImplicitFluidSystem::add_pressure(const std::vector<Vec3>& x, bool with_d0,
 // s_ *= Q, out += D^T s_
 void ImplicitFluidSystem::scatter_pressure(std::vector<Vec3>& out) const {
   const std::size_t n = out.size();
+  if (!inc_.empty()) {
+    detail::for_each_index(n, 1, [&](std::size_t a) { s_[a] *= q_[a]; });
+    detail::for_each_index(n, 1, [&](std::size_t a) {
+      Vec3 o = out[a] + s_[a] * tw_[a];
+      for (std::uint32_t k = inc_start_[a]; k < inc_start_[a + 1]; ++k) o += (s_[a] + s_[inc_[k].b]) * inc_[k].g;
+      out[a] = o;
+    });
+    return;
+  }
   for (std::size_t a = 0; a < n; ++a) {
     s_[a] *= q_[a];
     out[a] += s_[a] * tw_[a];
@@ -128,6 +165,23 @@ void ImplicitFluidSystem::scatter_pressure(std::vector<Vec3>& out) const {
 void ImplicitFluidSystem::apply(const std::vector<Vec3>& x, std::vector<Vec3>& out) const {
   const std::size_t n = x.size();
   out.resize(n);
+  if (!inc_.empty()) {
+    if (pressure_) s_.resize(n);
+    // the viscous product (and the divergence) gathered per particle
+    detail::for_each_index(n, 1, [&](std::size_t a) {
+      Vec3 o = vdiag_[a] * x[a];
+      double s = pressure_ ? tw_[a].dot(x[a]) : 0.0;
+      for (std::uint32_t k = inc_start_[a]; k < inc_start_[a + 1]; ++k) {
+        const Row& e = inc_[k];
+        o -= e.k * x[e.b];
+        if (pressure_) s += e.g.dot(x[a] - x[e.b]);
+      }
+      out[a] = o;
+      if (pressure_) s_[a] = s;
+    });
+    if (pressure_) scatter_pressure(out);
+    return;
+  }
   for (std::size_t a = 0; a < n; ++a) out[a] = vdiag_[a] * x[a];
   if (!pressure_) {
     by_rows(rows_, [&](std::uint32_t a, std::size_t first, std::size_t last) {

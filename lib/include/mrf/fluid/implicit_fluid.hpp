@@ -80,6 +80,10 @@ class ImplicitFluidSystem {
     Vec3 g;
   };
   std::vector<Row> rows_;
+  // on threads: per particle the rows it is an end of, in row order, as
+  // {it, the other end, k, +-g} (CSR; empty when the products run serially)
+  std::vector<std::uint32_t> inc_start_;
+  std::vector<Row> inc_;
   std::vector<double> kw_, vdiag_;  // Morris: -dt K per wall pair; diagonal of I - dt L
   std::vector<Vec3> tw_, diag_;     // pressure: T_a = sum_w g_aw; Jacobi diagonal
   std::vector<double> d0_, q_;           // pressure: d0_a, dt^2 S1 K_a / rho_a^2
