@@ -69,29 +69,35 @@ void copy_on_threads(const std::vector<T>& src, std::vector<T>& dst, std::size_t
   });
 }
 
-// The largest of value(i) over [0, n) and the first i where it is taken
-// (strictly larger than everything before it, as a serial pass keeps it;
-// at = n when nothing exceeds `floor`), on threads when n >= per_thread;
-// the blocks' results merged in order, so the same whatever the threads.
+// The largest value of a pass and where it was taken, as a serial pass in
+// order keeps it: the first strict maximum; nothing above 0 seen leaves
+// v = 0 and at = npos. Blocks' results merged in block order give the
+// serial result whatever the number of threads.
 struct Largest {
-  double v;
-  std::size_t at;
+  static constexpr std::size_t npos = static_cast<std::size_t>(-1);
+  double v = 0;
+  std::size_t at = npos;
+  void see(double x, std::size_t where) {
+    if (x > v) v = x, at = where;
+  }
+  void merge(const Largest& o) {
+    if (o.v > v) *this = o;
+  }
 };
+
+// The largest of value(i) over [0, n) and the first i where it is taken, on
+// threads when n >= per_thread.
 template <class Value>
-Largest largest_of(std::size_t n, std::size_t per_thread, double floor, Value&& value) {
+Largest largest_of(std::size_t n, std::size_t per_thread, Value&& value) {
   const int blocks = block_count(n, per_thread);
-  std::vector<Largest> part(static_cast<std::size_t>(blocks), Largest{floor, n});
+  std::vector<Largest> part(static_cast<std::size_t>(blocks));
   for_blocks(n, blocks, [&](std::size_t b, std::size_t lo, std::size_t hi) {
-    Largest best{floor, n};  // a local, stored once: the blocks' slots share a cache line
-    for (std::size_t i = lo; i < hi; ++i) {
-      const double v = value(i);
-      if (v > best.v) best = {v, i};
-    }
+    Largest best;  // a local, stored once: the blocks' slots share a cache line
+    for (std::size_t i = lo; i < hi; ++i) best.see(value(i), i);
     part[b] = best;
   });
-  Largest best{floor, n};
-  for (const Largest& p : part)
-    if (p.v > best.v) best = p;
+  Largest best;
+  for (const Largest& p : part) best.merge(p);
   return best;
 }
 

@@ -21,17 +21,6 @@ Vec3 pair_vector(const ContactPair& c, const std::vector<Vec3>& x, const WallPar
 // passes; fewer run on one thread.
 constexpr std::size_t k_dual_per_thread = 1024;
 
-// The largest |v| of a pass and the sphere it belongs to, as a serial pass
-// in order that keeps the first strict maximum finds it; merged block by
-// block in order, so whatever the number of threads.
-struct Worst {
-  double v = 0;
-  std::uint32_t i = 0;
-  bool set = false;
-  void see(double x, std::uint32_t at) {
-    if (std::abs(x) > v) v = std::abs(x), i = at, set = true;
-  }
-};
 }  // namespace
 
 // act_particles_, and where more than one thread runs the passes over the
@@ -317,7 +306,7 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
     move(pairs, dq_, false, y_out);
   };
   act_part_.resize(static_cast<std::size_t>(pair_blocks));
-  std::vector<Worst> worst_of(static_cast<std::size_t>(std::max(pair_blocks, 1)));
+  std::vector<detail::Largest> worst_of(static_cast<std::size_t>(std::max(pair_blocks, 1)));
   NewtonResult res;
   double prev_worst = 0, theta = 1.0;
   // the largest residual of the last two accepted iterates, and whether the
@@ -327,14 +316,14 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
   for (res.iterations = 1; res.iterations <= opt.max_iterations; ++res.iterations) {
     // Residuals at y, normals updated to y; y_next = b + M G(y) lambda. By
     // blocks of pairs, each listing its active pairs, joined in order.
-    worst_of.assign(static_cast<std::size_t>(pair_blocks), Worst{});
+    worst_of.assign(static_cast<std::size_t>(pair_blocks), detail::Largest{});
     detail::for_blocks(np, pair_blocks, [&](std::size_t blk, std::size_t lo, std::size_t hi) {
       // the block's own list and maximum, handed back at the end (as in
       // detail::in_blocks: act_'s header is next to the members read here)
       std::vector<std::uint32_t> mine;
       mine.swap(blk == 0 ? act_ : act_part_[blk]);
       mine.clear();
-      Worst w;
+      detail::Largest w;  // the largest |residual| and its sphere i
       for (std::size_t c = lo; c < hi; ++c) {
         const ContactPair& pc = pairs[c];
         const Vec3 r = pair_vector(pc, y, walls, mi);
@@ -349,7 +338,7 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
         // from zero force, of the Hertz law at the overlap y gives it.
         comp_[c] = lambda_[c] > 0 ? 2.0 * h_lambda / (3.0 * lambda_[c]) : 1.0 / hertz_local_stiffness(h, hertz_k);
         mine.push_back(static_cast<std::uint32_t>(c));
-        w.see(phi, pc.i);
+        w.see(std::abs(phi), pc.i);
       }
       mine.swap(blk == 0 ? act_ : act_part_[blk]);
       worst_of[blk] = w;
@@ -357,11 +346,8 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
     for (int blk = 1; blk < pair_blocks; ++blk)
       act_.insert(act_.end(), act_part_[static_cast<std::size_t>(blk)].begin(),
                   act_part_[static_cast<std::size_t>(blk)].end());
-    double worst = 0;
-    auto merge = [&](const Worst& w) {
-      if (w.set && w.v > worst) worst = w.v, res.worst = w.i;
-    };
-    for (const Worst& w : worst_of) merge(w);
+    detail::Largest worst_at;  // over both passes, in order
+    for (const detail::Largest& w : worst_of) worst_at.merge(w);
     index_spheres(pairs);
     detail::copy_on_threads(b, y_next_, k_dual_per_thread);
     move(pairs, lambda_, true, y_next_);
@@ -372,20 +358,22 @@ NewtonResult ContactDual::solve(const std::vector<ContactPair>& pairs, const std
     // converge only linearly (30 % more iterations).
     const std::size_t m = act_.size();
     const int act_blocks = detail::block_count(m, k_dual_per_thread);
-    worst_of.assign(static_cast<std::size_t>(act_blocks), Worst{});
+    worst_of.assign(static_cast<std::size_t>(act_blocks), detail::Largest{});
     detail::for_blocks(m, act_blocks, [&](std::size_t blk, std::size_t lo, std::size_t hi) {
-      Worst w;  // stored at the end: the blocks' slots share a cache line
+      detail::Largest w;  // stored at the end: the blocks' slots share a cache line
       for (std::size_t a = lo; a < hi; ++a) {
         const std::uint32_t c = act_[a];
         const ContactPair& pc = pairs[c];
         const Vec3 ry = pc.wall ? Vec3(y[pc.i] - y_next_[pc.i])
                                 : Vec3((y[pc.i] - y_next_[pc.i]) - (y[pc.k] - y_next_[pc.k]));
         rhs_[c] += n_[c].dot(ry);
-        w.see(rhs_[c], pc.i);
+        w.see(std::abs(rhs_[c]), pc.i);
       }
       worst_of[blk] = w;
     });
-    for (const Worst& w : worst_of) merge(w);
+    for (const detail::Largest& w : worst_of) worst_at.merge(w);
+    const double worst = worst_at.v;
+    if (worst_at.at != detail::Largest::npos) res.worst = static_cast<std::uint32_t>(worst_at.at);
     // Backtracking: an update that more than doubled the largest residual
     // is undone and taken at half its length (down to 1/8; each try counts
     // as an iteration). Without it the coupled solve can cycle: a contact

@@ -130,7 +130,7 @@ ImplicitStepper::Attempt ImplicitStepper::attempt(double dt, const ImplicitDrift
   // x_{n-1} + D_{n-1}, x_{n-2} + D_{n-1} + D_{n-2}, and x - D_n at t_{n+1}.
   // The error and the largest step off the imposed flow, each sphere's own.
   const Vec3 zero = Vec3::Zero();
-  a.error = detail::largest_of(n, k_spheres_per_thread, 0.0, [&](std::size_t i) {
+  a.error = detail::largest_of(n, k_spheres_per_thread, [&](std::size_t i) {
               const Vec3& dn = carried ? carrier_[i] : zero;
               const Vec3& d1 = carried && history_ >= 1 ? carrier_prev_[i] : zero;
               const Vec3& d2 = carried && history_ >= 2 ? carrier_prev2_[i] : zero;
@@ -144,7 +144,7 @@ ImplicitStepper::Attempt ImplicitStepper::attempt(double dt, const ImplicitDrift
               const Vec3 v_rel = !carried ? f.v[i] : history_ >= 1 ? Vec3(f.v[i] - d1 / dt_) : Vec3(f.v[i] - d.u[i]);
               return 0.5 * (f.x[i] - x0_[i] - dn - dt * v_rel).norm();
             }).v;
-  const detail::Largest moved = detail::largest_of(n, k_spheres_per_thread, 0.0, [&](std::size_t i) {
+  const detail::Largest moved = detail::largest_of(n, k_spheres_per_thread, [&](std::size_t i) {
     Vec3 step = f.x[i] - x0_[i];
     step.z() -= p_.shear_rate * dt * x0_[i].x();  // less the affine part (the candidates' bound)
     return step.norm();

@@ -14,13 +14,13 @@ constexpr std::size_t k_spheres_per_thread = 2048;  // of the displacement passe
 double max_displacement(const std::vector<Vec3>& x, const std::vector<Vec3>& ref, const Box& box) {
   const MinImageYZ mi(box);
   return std::sqrt(
-      detail::largest_of(x.size(), k_spheres_per_thread, 0.0, [&](std::size_t i) { return mi.norm2(x[i], ref[i]); }).v);
+      detail::largest_of(x.size(), k_spheres_per_thread, [&](std::size_t i) { return mi.norm2(x[i], ref[i]); }).v);
 }
 
 double max_nonaffine_displacement(const std::vector<Vec3>& x, const std::vector<Vec3>& ref, const Box& box,
                                   double strain) {
   const MinImageYZ mi(box);
-  return std::sqrt(detail::largest_of(x.size(), k_spheres_per_thread, 0.0, [&](std::size_t i) {
+  return std::sqrt(detail::largest_of(x.size(), k_spheres_per_thread, [&](std::size_t i) {
                      Vec3 d = mi.delta(x[i], ref[i]);
                      d.z() -= strain * ref[i].x();
                      return d.squaredNorm();
