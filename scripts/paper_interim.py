@@ -40,7 +40,9 @@ def interim_toml(src_path, archive, out_path):
     src = open(src_path).read()
     head, *rules = src.split("[[rule]]")
     rerun_start = src.index("# Re-runs for steadiness")
-    keep, pos, pending = [], len(head), []
+    keep, pos, pending = [], len(head), {}
+    # a rule without seeds covers every seed of the sweep
+    head_seeds = [int(x) for x in re.search(r"seeds\s*=\s*\[(.*?)\]", head).group(1).split(",")]
     for r in rules:
         start = pos
         pos += len("[[rule]]") + len(r)
@@ -52,7 +54,7 @@ def interim_toml(src_path, archive, out_path):
         lo = float(re.search(r"mason_min\s*=\s*([\d.e+-]+)", r).group(1))
         hi = float(re.search(r"mason_max\s*=\s*([\d.e+-]+)", r).group(1))
         sd_text = re.search(r"seeds\s*=\s*\[(.*?)\]", r)
-        seeds = [int(x) for x in sd_text.group(1).split(",")] if sd_text else [1]  # the convergence sweep: seed 1
+        seeds = [int(x) for x in sd_text.group(1).split(",")] if sd_text else head_seeds
         var_text = re.search(r"variants\s*=\s*\[(.*?)\]", r)
         variants = re.findall(r'"([\w.-]+)"', var_text.group(1)) if var_text else [""]
         sets = re.search(r"^set\s*=\s*\[(.*?)\]", r, re.S | re.M).group(1).strip()
@@ -63,15 +65,17 @@ def interim_toml(src_path, archive, out_path):
                 for mn in [g for g in GRID if lo <= g <= hi]:
                     for sd in seeds:
                         f = os.path.join(archive, m, v, f"mn_{mn:g}_seed_{sd}", "summary.json")
+                        key = (m, v, mn, sd)
                         if os.path.exists(f) and json.load(open(f))["strain"] == strain:
                             keep.append(("\nvariants = [\"" + v + "\"]" if v else "")
                                         + f'\nmodels = ["{m}"]\nmason_min = {mn!r}\nmason_max = {mn!r}\n'
                                         f'seeds = [{sd}]\nset = [{sets}]\n\n')
+                            pending.pop(key, None)  # a later rule's run has finished: the earlier one's is moot
                         else:
-                            pending.append(f"{m} {v + ' ' if v else ''}Mn {mn:g} seed {sd}")
+                            pending[key] = f"{m} {v + ' ' if v else ''}Mn {mn:g} seed {sd}"
     with open(out_path, "w") as fh:
         fh.write(head + "".join("[[rule]]" + r for r in keep))
-    return pending
+    return list(pending.values())
 
 
 def collect(mrf, toml, out, archive):
