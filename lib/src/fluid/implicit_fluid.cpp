@@ -44,10 +44,11 @@ ImplicitFluidSystem::ImplicitFluidSystem(const FluidCell& c, double dt, SphImpli
   rows_.resize(pairs.size());
   kw_.resize(wall_pairs.size());
   vdiag_.assign(n, 1.0);
+  const double scale = c.mass * c.density_scale;
   for (std::size_t e = 0; e < pairs.size(); ++e) {
     const SphPair& pr = pairs[e];
     const double k = -dt * morris_weight(pr.r, c.h, c.mass, effective_viscosity(c), rho[pr.a], rho[pr.b]);
-    rows_[e] = {pr.a, pr.b, k, Vec3::Zero()};
+    rows_[e] = {pr.a, pr.b, k, pressure_ ? Vec3(scale * kernel_dwdr_over_r(pr.r, c.h) * pr.r_ab) : Vec3::Zero()};
     vdiag_[pr.a] += k;
     vdiag_[pr.b] += k;
   }
@@ -69,20 +70,11 @@ ImplicitFluidSystem::ImplicitFluidSystem(const FluidCell& c, double dt, SphImpli
     inc_.resize(inc_start_[n]);
     std::vector<std::uint32_t> next(inc_start_.begin(), inc_start_.end() - 1);
     for (const Row& e : rows_) {
-      inc_[next[e.a]++] = {e.a, e.b, e.k, Vec3::Zero()};
-      inc_[next[e.b]++] = {e.b, e.a, e.k, Vec3::Zero()};
+      inc_[next[e.a]++] = {e.a, e.b, e.k, e.g};
+      inc_[next[e.b]++] = {e.b, e.a, e.k, -e.g};
     }
   }
   if (!pressure_) return;
-  const double scale = c.mass * c.density_scale;
-  for (std::size_t e = 0; e < pairs.size(); ++e) rows_[e].g = scale * kernel_dwdr_over_r(pairs[e].r, c.h) * pairs[e].r_ab;
-  if (!inc_.empty()) {
-    std::vector<std::uint32_t> next(inc_start_.begin(), inc_start_.end() - 1);
-    for (const Row& e : rows_) {
-      inc_[next[e.a]++].g = e.g;
-      inc_[next[e.b]++].g = -e.g;
-    }
-  }
   tw_.assign(n, Vec3::Zero());
   d0_.assign(n, 0.0);
   for (const SphPair& pr : wall_pairs) {
