@@ -128,6 +128,9 @@ class ImplicitStepper {
   const ImplicitCounters& counters() const { return counters_; }
   double dt() const { return dt_; }          // the last accepted step (s)
   double max_dt() const { return dt_max_; }  // s
+  // The contact candidates of the last step (pairs within 2R + margin at its
+  // start); the list-completeness test checks them.
+  const std::vector<ContactPair>& candidates() const { return candidates_; }
 
   // The history (last steps, next try, counters); the near list is derived.
   template <class Archive, class Self>

@@ -36,6 +36,7 @@ class DemModel final : public Model {
   void finish(RunSummary& s) const override;
   const ImplicitCounters& implicit_counters() const { return implicit_->counters(); }
   double max_dt() const { return implicit_ ? implicit_->max_dt() : dt_; }
+  const ImplicitStepper* implicit() const { return implicit_ ? &*implicit_ : nullptr; }
 
   const ShearCell& cell() const override { return cell_; }
   const DemParams& params() const { return p_; }
