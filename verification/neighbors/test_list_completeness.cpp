@@ -103,9 +103,11 @@ Tally check_run(const std::vector<std::string>& overrides) {
   }
   t.ff_builds = static_cast<std::size_t>(model->lists().ff_builds);
   t.strain = model->params().shear_rate * model->time();
-  std::printf("%zu steps checked, strain %.2f: %zu free-free builds, skin %.2f R, mean contacts %.0f, candidates %.0f\n",
-              t.steps, t.strain, t.ff_builds, model->lists().skin / r, double(t.contacts) / double(std::max<std::size_t>(t.steps, 1)),
-              double(t.candidates) / double(std::max<std::size_t>(t.steps, 1)));
+  const double per_step = 1.0 / static_cast<double>(std::max<std::size_t>(t.steps, 1));
+  std::printf("%zu steps checked, strain %.2f: %zu free-free builds, skin %.2f R, mean contacts %.0f, "
+              "candidates %.0f\n",
+              t.steps, t.strain, t.ff_builds, model->lists().skin / r, static_cast<double>(t.contacts) * per_step,
+              static_cast<double>(t.candidates) * per_step);
   return t;
 }
 
