@@ -84,6 +84,23 @@ def collect(mrf, toml, out, archive):
     subprocess.run([mrf, "criterion", out], check=True, stdout=subprocess.DEVNULL)
 
 
+def merge_extra_seeds(mrf, toml, archive, out):
+    """Appends the finished runs of an extra-seed sweep (paper_mn01_states.toml:
+    model 1 at Mn 0.1, seeds 4-8, fixed in advance) to the collected sweep in
+    `out` and runs `mrf criterion` again, so that the point's mean and error
+    bar take every seed. Returns the number of runs merged."""
+    if not os.path.isdir(archive):
+        return 0
+    extra = out + "_extra"
+    shutil.rmtree(extra, ignore_errors=True)
+    subprocess.run([mrf, "sweep", toml, "--out", extra, "--archive", archive, "--collect", "--quiet"], check=True)
+    rows = [line for line in open(os.path.join(extra, "sweep.csv")).read().splitlines()[1:] if ",ok," in line]
+    with open(os.path.join(out, "sweep.csv"), "a") as fh:
+        fh.writelines(line + "\n" for line in rows)
+    subprocess.run([mrf, "criterion", out], check=True, stdout=subprocess.DEVNULL)
+    return len(rows)
+
+
 def reanalysed(mrf, archive, out_path):
     """`mrf reanalyse` on every archive entry that keeps its window series
     (window_series.csv), one record per run with its model, Mn and seed:
@@ -111,10 +128,11 @@ def main():
     # where each sweep's finished points are read from
     if "--runs" in sys.argv:
         src = {n: os.path.join("out", "sweeps", n) for n in
-               ("paper_realistic", "paper_fixed_m", "paper_low_mn", "paper_convergence")}
+               ("paper_realistic", "paper_fixed_m", "paper_low_mn", "paper_convergence", "paper_mn01_states")}
     else:
         src = {"paper_realistic": f"{paper}/points", "paper_fixed_m": f"{paper}/fixed_m_points",
-               "paper_low_mn": f"{paper}/low_mn_points", "paper_convergence": f"{paper}/convergence/points"}
+               "paper_low_mn": f"{paper}/low_mn_points", "paper_convergence": f"{paper}/convergence/points",
+               "paper_mn01_states": f"{paper}/mn01_states/points"}
     tmp = os.path.join(sweeps, "_paper_interim.toml")  # beside the others: the scene path is relative
     try:
         for name, archive, csv_name, crit_name in (
@@ -124,6 +142,10 @@ def main():
             print(f"{name}: re-runs pending: {', '.join(pending) if pending else 'none'}")
             out = os.path.join("out", "sweeps", name + "_interim")
             collect(mrf, tmp, out, archive)
+            if name == "paper_realistic":
+                n = merge_extra_seeds(mrf, os.path.join(sweeps, "paper_mn01_states.toml"),
+                                      src["paper_mn01_states"], out)
+                print(f"paper_mn01_states: {n} runs of model 1 at Mn 0.1 merged into the headline point")
             shutil.copy(os.path.join(out, "sweep.csv"), os.path.join(paper, csv_name))
             shutil.copy(os.path.join(out, "criterion.json"), os.path.join(paper, crit_name))
         n = reanalysed(mrf, src["paper_realistic"], os.path.join(paper, "reanalysed.json"))
