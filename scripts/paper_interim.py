@@ -12,7 +12,10 @@ reports/study/paper/ and writes the report with --note NOTE. The fixed-M
 path's tables are refreshed from reports/study/paper/fixed_m_points the same
 way (a point whose re-run is pending reads as its first run there too), and
 so is the convergence table (reports/study/paper/convergence.md) from
-reports/study/paper/convergence/points.
+reports/study/paper/convergence/points. Model 1 at Mn 0.1 takes the extra
+seeds of experiments/sweeps/paper_mn01_states.toml into its headline point,
+and reports/paper_mn01_states.py shows every seed's window
+(reports/study/paper/mn01_states.md).
 
 With --runs the four sweeps are read from their run folders
 (out/sweeps/<sweep name>, laid out as an archive is) instead of the
@@ -174,6 +177,7 @@ def main():
     if "--note" in sys.argv:
         cmd += ["--note", arg("--note", "")]
     subprocess.run(cmd, check=True)
+    subprocess.run(["/usr/bin/python3", "reports/paper_mn01_states.py", paper], check=True)
     return 0
 
 
