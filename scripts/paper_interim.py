@@ -17,7 +17,7 @@ seeds of experiments/sweeps/paper_mn01_states.toml into its headline point,
 and reports/paper_mn01_states.py shows every seed's window
 (reports/study/paper/mn01_states.md).
 
-With --runs the four sweeps are read from their run folders
+With --runs the five sweeps are read from their run folders
 (out/sweeps/<sweep name>, laid out as an archive is) instead of the
 committed archives: what `scripts/reproduce paper` does after running them
 from scratch.
