@@ -31,10 +31,15 @@ def summary(d):
     return json.loads(f.read_text()) if f.exists() else None
 
 
+# archives of extra seeds beside the main one (paper_mn01_states.toml: model 1 at Mn 0.1, seeds 4-8)
+extra_archives = [archive.parent / "mn01_states" / "points"]
+
+
 def seed_sd(point):
-    """Sample SD of the total stress over the point's archived seeds."""
+    """Sample SD of the total stress over the point's archived seeds (the extra seeds' archives included)."""
     stem = re.sub(r"_seed_\d+$", "", point)
-    vals = [s["stress_total"] for f in sorted(archive.glob(stem + "_seed_*")) if (s := summary(f))]
+    vals = [s["stress_total"] for arch in [archive] + extra_archives
+            for f in sorted(arch.glob(stem + "_seed_*")) if (s := summary(f))]
     return (statistics.stdev(vals) if len(vals) > 1 else 0.0), len(vals)
 
 
