@@ -31,8 +31,9 @@ def summary(d):
     return json.loads(f.read_text()) if f.exists() else None
 
 
-# archives of extra seeds beside the main one (paper_mn01_states.toml: model 1 at Mn 0.1, seeds 4-8)
-extra_archives = [archive.parent / "mn01_states" / "points"]
+# archives of extra seeds beside the main one (model 1, seeds 4-8: paper_mn01_states.toml,
+# paper_model1_seeds.toml)
+extra_archives = [archive.parent / "mn01_states" / "points", archive.parent / "model1_seeds" / "points"]
 
 
 def seed_sd(point):

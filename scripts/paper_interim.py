@@ -12,12 +12,13 @@ reports/study/paper/ and writes the report with --note NOTE. The fixed-M
 path's tables are refreshed from reports/study/paper/fixed_m_points the same
 way (a point whose re-run is pending reads as its first run there too), and
 so is the convergence table (reports/study/paper/convergence.md) from
-reports/study/paper/convergence/points. Model 1 at Mn 0.1 takes the extra
-seeds of experiments/sweeps/paper_mn01_states.toml into its headline point,
+reports/study/paper/convergence/points. Model 1 takes the extra seeds of
+experiments/sweeps/paper_mn01_states.toml (Mn 0.1) and
+paper_model1_seeds.toml (the other Mn) into its headline points,
 and reports/paper_mn01_states.py shows every seed's window
 (reports/study/paper/mn01_states.md).
 
-With --runs the five sweeps are read from their run folders
+With --runs the six sweeps are read from their run folders
 (out/sweeps/<sweep name>, laid out as an archive is) instead of the
 committed archives: what `scripts/reproduce paper` does after running them
 from scratch.
@@ -87,14 +88,19 @@ def collect(mrf, toml, out, archive):
     subprocess.run([mrf, "criterion", out], check=True, stdout=subprocess.DEVNULL)
 
 
+# Extra-seed sweeps of the headline (model 1, seeds 4-8, each fixed in
+# advance): sweep name and committed archive.
+EXTRA_SEEDS = [("paper_mn01_states", "mn01_states/points"), ("paper_model1_seeds", "model1_seeds/points")]
+
+
 def merge_extra_seeds(mrf, toml, archive, out):
-    """Appends the finished runs of an extra-seed sweep (paper_mn01_states.toml:
-    model 1 at Mn 0.1, seeds 4-8, fixed in advance) to the collected sweep in
-    `out` and runs `mrf criterion` again, so that the point's mean and error
-    bar take every seed. Returns the number of runs merged."""
+    """Appends the finished runs of an extra-seed sweep (EXTRA_SEEDS) to the
+    collected sweep in `out` and runs `mrf criterion` again, so that the
+    points' means and error bars take every seed. Returns the number of runs
+    merged."""
     if not os.path.isdir(archive):
         return 0
-    extra = out + "_extra"
+    extra = out + "_" + os.path.basename(toml)[:-len(".toml")]
     shutil.rmtree(extra, ignore_errors=True)
     subprocess.run([mrf, "sweep", toml, "--out", extra, "--archive", archive, "--collect", "--quiet"], check=True)
     rows = [line for line in open(os.path.join(extra, "sweep.csv")).read().splitlines()[1:] if ",ok," in line]
@@ -130,12 +136,12 @@ def main():
     sweeps = "experiments/sweeps"
     # where each sweep's finished points are read from
     if "--runs" in sys.argv:
-        src = {n: os.path.join("out", "sweeps", n) for n in
-               ("paper_realistic", "paper_fixed_m", "paper_low_mn", "paper_convergence", "paper_mn01_states")}
+        names = ["paper_realistic", "paper_fixed_m", "paper_low_mn", "paper_convergence"] + [n for n, _ in EXTRA_SEEDS]
+        src = {n: os.path.join("out", "sweeps", n) for n in names}
     else:
         src = {"paper_realistic": f"{paper}/points", "paper_fixed_m": f"{paper}/fixed_m_points",
-               "paper_low_mn": f"{paper}/low_mn_points", "paper_convergence": f"{paper}/convergence/points",
-               "paper_mn01_states": f"{paper}/mn01_states/points"}
+               "paper_low_mn": f"{paper}/low_mn_points", "paper_convergence": f"{paper}/convergence/points"}
+        src.update({n: f"{paper}/{a}" for n, a in EXTRA_SEEDS})
     tmp = os.path.join(sweeps, "_paper_interim.toml")  # beside the others: the scene path is relative
     try:
         for name, archive, csv_name, crit_name in (
@@ -145,10 +151,9 @@ def main():
             print(f"{name}: re-runs pending: {', '.join(pending) if pending else 'none'}")
             out = os.path.join("out", "sweeps", name + "_interim")
             collect(mrf, tmp, out, archive)
-            if name == "paper_realistic":
-                n = merge_extra_seeds(mrf, os.path.join(sweeps, "paper_mn01_states.toml"),
-                                      src["paper_mn01_states"], out)
-                print(f"paper_mn01_states: {n} runs of model 1 at Mn 0.1 merged into the headline point")
+            for extra, _ in EXTRA_SEEDS if name == "paper_realistic" else []:
+                n = merge_extra_seeds(mrf, os.path.join(sweeps, extra + ".toml"), src[extra], out)
+                print(f"{extra}: {n} runs of model 1 merged into the headline points")
             shutil.copy(os.path.join(out, "sweep.csv"), os.path.join(paper, csv_name))
             shutil.copy(os.path.join(out, "criterion.json"), os.path.join(paper, crit_name))
         n = reanalysed(mrf, src["paper_realistic"], os.path.join(paper, "reanalysed.json"))
