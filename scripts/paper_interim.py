@@ -15,8 +15,8 @@ so is the convergence table (reports/study/paper/convergence.md) from
 reports/study/paper/convergence/points. Model 1 takes the extra seeds of
 experiments/sweeps/paper_mn01_states.toml (Mn 0.1) and
 paper_model1_seeds.toml (the other Mn) into its headline points,
-and reports/paper_mn01_states.py shows every seed's window
-(reports/study/paper/mn01_states.md).
+and reports/paper_model1_seeds.py shows every seed's window
+(reports/study/paper/model1_seeds.md).
 
 With --runs the six sweeps are read from their run folders
 (out/sweeps/<sweep name>, laid out as an archive is) instead of the
@@ -182,7 +182,7 @@ def main():
     if "--note" in sys.argv:
         cmd += ["--note", arg("--note", "")]
     subprocess.run(cmd, check=True)
-    subprocess.run(["/usr/bin/python3", "reports/paper_mn01_states.py", paper], check=True)
+    subprocess.run(["/usr/bin/python3", "reports/paper_model1_seeds.py", paper], check=True)
     return 0
 
 
