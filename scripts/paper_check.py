@@ -31,9 +31,11 @@ def summary(d):
     return json.loads(f.read_text()) if f.exists() else None
 
 
-# archives of extra seeds beside the main one (model 1, seeds 4-8: paper_mn01_states.toml,
-# paper_model1_seeds.toml)
-extra_archives = [archive.parent / "mn01_states" / "points", archive.parent / "model1_seeds" / "points"]
+# archives of extra seeds beside the main one (model 1, seeds 4-8), as the report merges them
+sys.path.insert(0, str(root / "scripts"))
+from paper_interim import EXTRA_SEEDS  # noqa: E402
+
+extra_archives = [archive.parent / folder for _, folder in EXTRA_SEEDS]
 
 
 def seed_sd(point):
