@@ -27,33 +27,31 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 
+# the headline's archive and the extra-seed archives (scripts/paper_interim.py, EXTRA_SEEDS)
 FOLDERS = ("points", "mn01_states/points", "model1_seeds/points")
+
+
+def run_dirs(paper, mn):
+    """(seed, folder) of every archived model-1 run at Mn `mn`, by seed."""
+    out = [(seed, d) for folder in FOLDERS for seed in range(1, 100)
+           if os.path.exists(os.path.join(d := os.path.join(paper, folder, "dem_stokes", f"mn_{mn:g}_seed_{seed}"),
+                                          "summary.json"))]
+    return sorted(out)
 
 
 def summaries(paper, mn):
     """(seed, summary) of every archived model-1 run at Mn `mn`."""
-    out = []
-    for folder in FOLDERS:
-        for seed in range(1, 100):
-            f = os.path.join(paper, folder, "dem_stokes", f"mn_{mn:g}_seed_{seed}", "summary.json")
-            if os.path.exists(f):
-                out.append((seed, json.load(open(f))))
-    return sorted(out, key=lambda r: r[0])
+    return [(seed, json.load(open(os.path.join(d, "summary.json")))) for seed, d in run_dirs(paper, mn)]
 
 
 def runs(paper):
+    """(seed, summary, strain, particle part) of every run at Mn 0.1, over its averaging window."""
     out = []
-    for folder in FOLDERS:
-        for seed in range(1, 100):
-            d = os.path.join(paper, folder, "dem_stokes", f"mn_0.1_seed_{seed}")
-            if not os.path.exists(os.path.join(d, "summary.json")):
-                continue
-            s = json.load(open(os.path.join(d, "summary.json")))
-            rows = list(csv.DictReader(open(os.path.join(d, "window_series.csv"))))
-            strain = [float(r["strain"]) for r in rows]
-            part = [float(r["stress_particles_Pa"]) for r in rows]
-            out.append((seed, s, strain, part))
-    return sorted(out, key=lambda r: r[0])
+    for seed, d in run_dirs(paper, 0.1):
+        s = json.load(open(os.path.join(d, "summary.json")))
+        rows = list(csv.DictReader(open(os.path.join(d, "window_series.csv"))))
+        out.append((seed, s, [float(r["strain"]) for r in rows], [float(r["stress_particles_Pa"]) for r in rows]))
+    return out
 
 
 def bins(strain, values, lo, hi, width):
