@@ -95,18 +95,17 @@ EXTRA_SEEDS = [("paper_mn01_states", "mn01_states/points"), ("paper_model1_seeds
 
 def merge_extra_seeds(mrf, toml, archive, out):
     """Appends the finished runs of an extra-seed sweep (EXTRA_SEEDS) to the
-    collected sweep in `out` and runs `mrf criterion` again, so that the
-    points' means and error bars take every seed. Returns the number of runs
-    merged."""
+    collected sweep in `out` (its `mrf criterion` is to be run again after,
+    so that the points' means and error bars take every seed). Returns the
+    number of runs merged."""
     if not os.path.isdir(archive):
         return 0
     extra = out + "_" + os.path.basename(toml)[:-len(".toml")]
     shutil.rmtree(extra, ignore_errors=True)
     subprocess.run([mrf, "sweep", toml, "--out", extra, "--archive", archive, "--collect", "--quiet"], check=True)
-    rows = [line for line in open(os.path.join(extra, "sweep.csv")).read().splitlines()[1:] if ",ok," in line]
+    rows = open(os.path.join(extra, "sweep.csv")).read().splitlines()[1:]
     with open(os.path.join(out, "sweep.csv"), "a") as fh:
         fh.writelines(line + "\n" for line in rows)
-    subprocess.run([mrf, "criterion", out], check=True, stdout=subprocess.DEVNULL)
     return len(rows)
 
 
@@ -151,9 +150,14 @@ def main():
             print(f"{name}: re-runs pending: {', '.join(pending) if pending else 'none'}")
             out = os.path.join("out", "sweeps", name + "_interim")
             collect(mrf, tmp, out, archive)
-            for extra, _ in EXTRA_SEEDS if name == "paper_realistic" else []:
-                n = merge_extra_seeds(mrf, os.path.join(sweeps, extra + ".toml"), src[extra], out)
-                print(f"{extra}: {n} runs of model 1 merged into the headline points")
+            if name == "paper_realistic":
+                merged = 0
+                for extra, _ in EXTRA_SEEDS:
+                    n = merge_extra_seeds(mrf, os.path.join(sweeps, extra + ".toml"), src[extra], out)
+                    print(f"{extra}: {n} runs of model 1 merged into the headline points")
+                    merged += n
+                if merged:
+                    subprocess.run([mrf, "criterion", out], check=True, stdout=subprocess.DEVNULL)
             shutil.copy(os.path.join(out, "sweep.csv"), os.path.join(paper, csv_name))
             shutil.copy(os.path.join(out, "criterion.json"), os.path.join(paper, crit_name))
         n = reanalysed(mrf, src["paper_realistic"], os.path.join(paper, "reanalysed.json"))
