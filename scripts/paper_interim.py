@@ -16,9 +16,11 @@ reports/study/paper/convergence/points. Model 1 takes the extra seeds of
 experiments/sweeps/paper_mn01_states.toml (Mn 0.1) and
 paper_model1_seeds.toml (the other Mn) into its headline points,
 and reports/paper_model1_seeds.py shows every seed's window
-(reports/study/paper/model1_seeds.md).
+(reports/study/paper/model1_seeds.md). reports/paper_tolerance.py applies
+the rules of experiments/sweeps/paper_tolerance.toml and
+paper_tolerance_coupled.toml to their runs (reports/study/paper/tolerance.md).
 
-With --runs the six sweeps are read from their run folders
+With --runs the eight sweeps are read from their run folders
 (out/sweeps/<sweep name>, laid out as an archive is) instead of the
 committed archives: what `scripts/reproduce paper` does after running them
 from scratch.
@@ -187,6 +189,8 @@ def main():
         cmd += ["--note", arg("--note", "")]
     subprocess.run(cmd, check=True)
     subprocess.run(["/usr/bin/python3", "reports/paper_model1_seeds.py", paper], check=True)
+    subprocess.run(["/usr/bin/python3", "reports/paper_tolerance.py", paper] + (["--runs"] if "--runs" in sys.argv else []),
+                   check=True)
     return 0
 
 
