@@ -124,10 +124,14 @@ def section(d, runs, rows, thresholds, chosen):
         out += [f"**Chosen tolerance: {chosen:g}** ({verdict}).", ""]
     for mn in d.mason:
         out += [f"### Mn {mn:g}", "", f"T = {thresholds[mn]:.4f} Pa" if thresholds[mn] else "T: no reference runs yet",
-                "", "| tolerance | seeds | b (Pa) | SE (Pa) | abs(b) + 2 SE | passes | mean steps | mean wall s | "
-                "unsteady runs |", "|---:|---:|---:|---:|---:|---|---:|---:|---|"]
+                "", "| tolerance | seeds | b (Pa) | SE (Pa) | abs(b) + 2 SE | passes | seed mean (Pa) | seed SD | "
+                "mean run error | mean steps | mean wall s | unsteady runs |",
+                "|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---|"]
         for t in d.tols:
             have = [runs[mn][t][s] for s in d.seeds if runs[mn][t][s]]
+            mean = statistics.fmean(r["stress_total"] for r in have) if have else float("nan")
+            sd = statistics.stdev(r["stress_total"] for r in have) if len(have) > 1 else float("nan")
+            err = statistics.fmean(r["stress_total_err"] for r in have) if have else float("nan")
             steps = statistics.fmean(r["steps"] for r in have) if have else float("nan")
             wall = statistics.fmean(r["wall_seconds"] for r in have) if have else float("nan")
             unsteady = ", ".join(str(s) for s in d.seeds if runs[mn][t][s] and not steady(runs[mn][t][s])) or "-"
@@ -138,7 +142,9 @@ def section(d, runs, rows, thresholds, chosen):
                 cells = ["", "", "", "not yet"]
             else:
                 cells = [f"{r['b']:+.4f}", f"{r['se']:.4f}", f"{r['bound']:.4f}", "yes" if r["pass"] else "**no**"]
-            out.append(f"| {t:g} | {len(have)} | " + " | ".join(cells) + f" | {steps:.0f} | {wall:.0f} | {unsteady} |")
+            out.append(f"| {t:g} | {len(have)} | " + " | ".join(cells) + f" | {mean:.3f} | {sd:.3f} | {err:.3f} | "
+                       f"{steps:.0f} | {wall:.0f} | {unsteady} |")
+        out += ["", "The seed mean, seed SD and mean run error are shown beside the rule, not part of it."]
         fit = order_fit(rows, mn)
         if fit:
             q, c = fit
