@@ -12,7 +12,12 @@ seeds with the standard error from their scatter (model1_mn01_windows.png:
 each run's particle part in 10-strain bins); at every Mn the seed standard
 deviation of seeds 1-3 against all seeds.
 
-usage: reports/paper_model1_seeds.py [paper folder, default reports/study/paper]
+With --runs the runs are read from the sweeps' run folders
+(out/sweeps/paper_realistic, paper_mn01_states, paper_model1_seeds), as
+`scripts/reproduce paper` leaves them, and a run's averaging window from its
+timeseries.csv (the rows an archive's window_series.csv keeps).
+
+usage: reports/paper_model1_seeds.py [paper folder, default reports/study/paper] [--runs]
 """
 import csv
 import json
@@ -27,29 +32,49 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 
-# the headline's archive and the extra-seed archives (scripts/paper_interim.py, EXTRA_SEEDS)
-FOLDERS = ("points", "mn01_states/points", "model1_seeds/points")
+# the headline's archive and the extra-seed archives (scripts/paper_interim.py,
+# EXTRA_SEEDS), and the sweeps whose run folders hold the same runs
+FOLDERS = (("points", "paper_realistic"), ("mn01_states/points", "paper_mn01_states"),
+           ("model1_seeds/points", "paper_model1_seeds"))
 
 
-def run_dirs(paper, mn):
-    """(seed, folder) of every archived model-1 run at Mn `mn`, by seed."""
-    out = [(seed, d) for folder in FOLDERS for seed in range(1, 100)
-           if os.path.exists(os.path.join(d := os.path.join(paper, folder, "dem_stokes", f"mn_{mn:g}_seed_{seed}"),
+def roots(paper, from_runs):
+    return [os.path.join("out", "sweeps", sweep) if from_runs else os.path.join(paper, archive)
+            for archive, sweep in FOLDERS]
+
+
+def run_dirs(folders, mn):
+    """(seed, folder) of every model-1 run at Mn `mn` under `folders`, by seed."""
+    out = [(seed, d) for folder in folders for seed in range(1, 100)
+           if os.path.exists(os.path.join(d := os.path.join(folder, "dem_stokes", f"mn_{mn:g}_seed_{seed}"),
                                           "summary.json"))]
     return sorted(out)
 
 
-def summaries(paper, mn):
-    """(seed, summary) of every archived model-1 run at Mn `mn`."""
-    return [(seed, json.load(open(os.path.join(d, "summary.json")))) for seed, d in run_dirs(paper, mn)]
+def window_rows(d, warmup):
+    """The rows of a run's averaging window: window_series.csv where an archive kept it, else the rows of
+    timeseries.csv from the one before the first whose predecessor has reached the warm-up (as mrf's
+    window_series_text takes them)."""
+    path = os.path.join(d, "window_series.csv")
+    if os.path.exists(path):
+        return list(csv.DictReader(open(path)))
+    rows = list(csv.DictReader(open(os.path.join(d, "timeseries.csv"))))
+    first = next((r for r in range(len(rows))
+                  if (float(rows[r - 1]["strain"]) if r else 0.0) >= warmup * (1 - 1e-12)), len(rows))
+    return rows[max(first - 1, 0):]
 
 
-def runs(paper):
+def summaries(folders, mn):
+    """(seed, summary) of every model-1 run at Mn `mn`."""
+    return [(seed, json.load(open(os.path.join(d, "summary.json")))) for seed, d in run_dirs(folders, mn)]
+
+
+def runs(folders):
     """(seed, summary, strain, particle part) of every run at Mn 0.1, over its averaging window."""
     out = []
-    for seed, d in run_dirs(paper, 0.1):
+    for seed, d in run_dirs(folders, 0.1):
         s = json.load(open(os.path.join(d, "summary.json")))
-        rows = list(csv.DictReader(open(os.path.join(d, "window_series.csv"))))
+        rows = window_rows(d, s["warmup_strain"])
         out.append((seed, s, [float(r["strain"]) for r in rows], [float(r["stress_particles_Pa"]) for r in rows]))
     return out
 
@@ -64,8 +89,10 @@ def bins(strain, values, lo, hi, width):
 
 
 def main():
-    paper = sys.argv[1] if len(sys.argv) > 1 else "reports/study/paper"
-    rs = runs(paper)
+    args = [a for a in sys.argv[1:] if a != "--runs"]
+    paper = args[0] if args else "reports/study/paper"
+    folders = roots(paper, "--runs" in sys.argv)
+    rs = runs(folders)
     if not rs:
         print("paper_model1_seeds: no runs")
         return 0
@@ -107,7 +134,7 @@ def main():
               "| Mn | seeds | mean (Pa) | SD, seeds 1-3 | SD, all seeds | run error | unsteady runs |",
               "|---|---|---|---|---|---|---|"]
     for mn in (1e-3, 1e-2, 0.1, 1.0, 10.0):
-        ss = summaries(paper, mn)
+        ss = summaries(folders, mn)
         tot = [s["stress_total"] for _, s in ss]
         first = [s["stress_total"] for sd, s in ss if sd <= 3]
         bad = [str(sd) for sd, s in ss

@@ -188,9 +188,9 @@ def main():
     if "--note" in sys.argv:
         cmd += ["--note", arg("--note", "")]
     subprocess.run(cmd, check=True)
-    subprocess.run(["/usr/bin/python3", "reports/paper_model1_seeds.py", paper], check=True)
-    subprocess.run(["/usr/bin/python3", "reports/paper_tolerance.py", paper] + (["--runs"] if "--runs" in sys.argv else []),
-                   check=True)
+    runs = ["--runs"] if "--runs" in sys.argv else []
+    subprocess.run(["/usr/bin/python3", "reports/paper_model1_seeds.py", paper] + runs, check=True)
+    subprocess.run(["/usr/bin/python3", "reports/paper_tolerance.py", paper] + runs, check=True)
     return 0
 
 
