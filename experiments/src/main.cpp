@@ -1,5 +1,6 @@
 // The `mrf` command line (DESIGN.md §Interfaces).
 //   mrf run SCENE.toml [--set section.key=value]... [--out DIR] [--quiet] [--resume] [--checkpoint-every S]
+//           [--branch-from STATE] [--keep-final-state]
 //   mrf criterion SWEEP_DIR|RUN_DIR [--thresholds FILE]
 //   mrf quasistatic SCENE.toml [--set k=v]... [--out DIR] [--increment D] [--tol T] [--strain S] [--warmup W]
 //             [--cutoff R] [--no-affine] [--minimiser fire|lbfgs] [--lbfgs-memory M] [--resume]
@@ -32,14 +33,11 @@ std::string join(const std::vector<std::string>& v) {
 }
 
 int run_command(const std::string& scene_path, const std::vector<std::string>& sets, std::string out, bool quiet,
-                bool resume, double checkpoint_seconds) {
+                mrf::RunOptions opt) {
   const mrf::LoadedScene scene = mrf::load_scene(scene_path, sets);
   if (out.empty()) out = "out/" + std::filesystem::path(scene_path).stem().string();
-  mrf::RunOptions opt;
   opt.out_dir = out;
   opt.quiet = quiet;
-  opt.resume = resume;
-  opt.checkpoint_seconds = checkpoint_seconds;
   const mrf::RunSummary s = mrf::run_scene(scene, opt);
   std::printf("%s Mn=%.4g: stress_total = %.6g +- %.2g Pa (particles %.6g, fluid %.6g, virial %.6g +- %.2g), "
               "drift z = %.2f; %ld steps, %.1f s -> %s/summary.json\n",
@@ -211,10 +209,17 @@ int main(int argc, char** argv) {
   run->add_option("--set", sets, "override one key: section.key=value (repeatable)");
   run->add_option("--out", out, "output directory (default out/<scene name>)");
   run->add_flag("--quiet", quiet, "no start-up table or progress on stderr");
-  bool resume = false;
-  double checkpoint_seconds = 60;
-  run->add_flag("--resume", resume, "continue from OUT/checkpoint.bin if it exists (same scene and overrides)");
-  run->add_option("--checkpoint-every", checkpoint_seconds, "wall seconds between checkpoints (0 = none)")->capture_default_str();
+  mrf::RunOptions run_opt;
+  run->add_flag("--resume", run_opt.resume, "continue from OUT/checkpoint.bin if it exists (same scene and overrides)");
+  run->add_option("--checkpoint-every", run_opt.checkpoint_seconds, "wall seconds between checkpoints (0 = none)")
+      ->capture_default_str();
+  run->add_option("--branch-from", run_opt.branch_from,
+                  "start from this state of another run (its checkpoint.bin or final_state.bin) unless OUT holds a "
+                  "checkpoint to resume; the scene may differ only in drive.strain, drive.warmup_strain, scene.seed, "
+                  "output.* and numerics.dt, skin, dt_safety, implicit_tol, newton_tol, threads")
+      ->check(CLI::ExistingFile);
+  run->add_flag("--keep-final-state", run_opt.keep_final_state,
+                "write OUT/final_state.bin at the end (for --branch-from)");
   auto* exp = app.add_subcommand("export-lammps", "write the scene's initial configuration as a LAMMPS data file");
   std::string exp_scene, exp_out;
   std::vector<std::string> exp_sets;
@@ -297,7 +302,7 @@ int main(int argc, char** argv) {
       for (const auto& d : ra_dirs) std::printf("%s\n", mrf::reanalyse_run(d).c_str());
       return 0;
     }
-    if (*run) return run_command(scene, sets, out, quiet, resume, checkpoint_seconds);
+    if (*run) return run_command(scene, sets, out, quiet, run_opt);
     if (*exp) return export_lammps(exp_scene, exp_sets, exp_out);
     if (*cr) return criterion_command(cr_path, cr_thresholds);
     if (*sw) return sweep_command(sa);

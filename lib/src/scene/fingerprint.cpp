@@ -59,28 +59,50 @@ std::string scene_fingerprint(const SceneConfig& c) {
   return out;
 }
 
+namespace {
+// the fields as written (numbers in hex), keyed by position
+std::vector<std::pair<std::string, std::string>> fingerprint_fields(const std::string& fp) {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (std::size_t start = 0, k = 0; start <= fp.size(); ++k) {
+    const std::size_t end = std::min(fp.find(';', start), fp.size());
+    std::string text = fp.substr(start, end - start);
+    std::string key = k < k_fingerprint_fields ? k_fingerprint_keys[k] : "field " + std::to_string(k + 1);
+    if (text.rfind(k_newton_tol_tag, 0) == 0) key = "numerics.newton_tol", text.erase(0, std::strlen(k_newton_tol_tag));
+    out.emplace_back(key, text);
+    start = end + 1;
+  }
+  return out;
+}
+
+std::size_t base_fields(const std::vector<std::pair<std::string, std::string>>& f) {
+  return f.size() - (f.back().first == "numerics.newton_tol" ? 1 : 0);
+}
+
+std::string value_in(const std::vector<std::pair<std::string, std::string>>& f, const std::string& key) {
+  for (const auto& [k, v] : f)
+    if (k == key) return v;
+  return std::string();  // numerics.newton_tol at its default
+}
+}  // namespace
+
+std::vector<std::string> fingerprint_keys_differing(const std::string& was, const std::string& now) {
+  const auto a = fingerprint_fields(was), b = fingerprint_fields(now);
+  if (base_fields(a) != k_fingerprint_fields || base_fields(b) != k_fingerprint_fields) return {"(format)"};
+  std::vector<std::string> out;
+  for (std::size_t k = 0; k <= k_fingerprint_fields; ++k) {
+    const std::string key = k < k_fingerprint_fields ? k_fingerprint_keys[k] : "numerics.newton_tol";
+    if (value_in(a, key) != value_in(b, key)) out.push_back(key);
+  }
+  return out;
+}
+
 std::string fingerprint_difference(const std::string& was, const std::string& now) {
   if (was == now) return "";
-  // the fields as written (numbers in hex), keyed by position
-  auto fields = [](const std::string& fp) {
-    std::vector<std::pair<std::string, std::string>> out;
-    for (std::size_t start = 0, k = 0; start <= fp.size(); ++k) {
-      const std::size_t end = std::min(fp.find(';', start), fp.size());
-      std::string text = fp.substr(start, end - start);
-      std::string key = k < k_fingerprint_fields ? k_fingerprint_keys[k] : "field " + std::to_string(k + 1);
-      if (text.rfind(k_newton_tol_tag, 0) == 0) key = "numerics.newton_tol", text.erase(0, std::strlen(k_newton_tol_tag));
-      out.emplace_back(key, text);
-      start = end + 1;
-    }
-    return out;
-  };
-  const auto a = fields(was), b = fields(now);
-  const auto base = [](const std::vector<std::pair<std::string, std::string>>& f) {
-    return f.size() - (f.back().first == "numerics.newton_tol" ? 1 : 0);
-  };
-  if (base(a) != k_fingerprint_fields || base(b) != k_fingerprint_fields)
-    return "the checkpoint's scene fingerprint has " + std::to_string(base(a)) + " fields where this version writes " +
-           std::to_string(k_fingerprint_fields) + ": it comes from another version of mrf";
+  const auto a = fingerprint_fields(was), b = fingerprint_fields(now);
+  if (base_fields(a) != k_fingerprint_fields || base_fields(b) != k_fingerprint_fields)
+    return "the checkpoint's scene fingerprint has " + std::to_string(base_fields(a)) +
+           " fields where this version writes " + std::to_string(k_fingerprint_fields) +
+           ": it comes from another version of mrf";
   // a value for display: a number in %.10g, or in %.17g where the two
   // values differ beyond ten digits; numerics.dt -1 is "auto"
   auto show = [](const std::string& key, const std::string& text, int digits) {
@@ -91,16 +113,9 @@ std::string fingerprint_difference(const std::string& was, const std::string& no
     std::snprintf(buf, sizeof buf, "%.*g", digits, v);
     return std::string(buf);
   };
-  auto value_in = [](const std::vector<std::pair<std::string, std::string>>& f, const std::string& key) {
-    for (const auto& [k, v] : f)
-      if (k == key) return v;
-    return std::string();  // numerics.newton_tol at its default
-  };
   std::string out;
-  for (std::size_t k = 0; k <= k_fingerprint_fields; ++k) {
-    const std::string key = k < k_fingerprint_fields ? k_fingerprint_keys[k] : "numerics.newton_tol";
+  for (const std::string& key : fingerprint_keys_differing(was, now)) {
     const std::string va = value_in(a, key), vb = value_in(b, key);
-    if (va == vb) continue;
     std::string sa = show(key, va, 10), sb = show(key, vb, 10);
     if (sa == sb) sa = show(key, va, 17), sb = show(key, vb, 17);
     if (va.empty()) sa = "1e-06 (default)";

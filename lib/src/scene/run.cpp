@@ -19,15 +19,22 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
   // steps of their largest dt, i.e. by strain interval; fixed steps write a
   // row every `every` steps.
   const bool adaptive = model.adaptive();
-  const double t_end = c.strain / c.shear_rate;
-  model.set_stop_time(t_end);
   const long every = series_every(scene, built.planned_steps);
   const long frame_every = c.frames > 0 ? std::max(1L, built.planned_steps / c.frames) : 0;
   RunFiles files(opt, c);
   LoopState st;
-  if (files.open(st, frame_every > 0, [&](ArchiveReader& in) { model.load(in); }) && !opt.quiet)
+  const RunFiles::Start start = files.open(st, frame_every > 0, [&](ArchiveReader& in) { model.load(in); });
+  if (start == RunFiles::Start::branched) st.t_origin = st.row_start = model.time();
+  // this run's strain: from its start (a branch's start is its parent's time)
+  const auto run_strain = [&] { return (model.time() - st.t_origin) * c.shear_rate; };
+  if (start == RunFiles::Start::resumed && !opt.quiet)
     std::fprintf(stderr, "  resuming from %s at step %ld (strain %.4g)\n", files.checkpoint().c_str(), st.n,
+                 run_strain());
+  if (start == RunFiles::Start::branched && !opt.quiet)
+    std::fprintf(stderr, "  branching from %s at its strain %.4g\n", opt.branch_from.c_str(),
                  model.time() * c.shear_rate);
+  const double t_end = st.t_origin + c.strain / c.shear_rate;
+  model.set_stop_time(t_end);
   SeriesRow row;
   const auto t0 = std::chrono::steady_clock::now();
   auto last_report = t0;
@@ -45,10 +52,10 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
       write_frame(files.frames, model.cell(), c.radius, model.time());
     const bool row_due = adaptive ? model.time() >= st.row_start + row_time * (1 - 1e-9) : n % every == 0;
     if (!row_due && running()) continue;
-    const double strain = model.time() * c.shear_rate;
+    const double strain = run_strain();
     st.max_overlap = std::max(st.max_overlap, row.max_overlap);
-    if (files.series.is_open()) write_series_row(files.series, model.time(), strain, row, c.radius);
-    if (st.row_start * c.shear_rate >= c.warmup_strain * (1 - 1e-12)) {  // whole rows after warm-up
+    if (files.series.is_open()) write_series_row(files.series, model.time() - st.t_origin, strain, row, c.radius);
+    if ((st.row_start - st.t_origin) * c.shear_rate >= c.warmup_strain * (1 - 1e-12)) {  // whole rows after warm-up
       const bool structure = st.se.rows() % structure_every == 0;
       if (structure) row.clusters = cluster_stats(model.cell(), c.radius);
       st.se.push(row, structure);

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <iterator>
 #include <fstream>
 #include <limits>
 #include <string>
@@ -226,8 +227,9 @@ RunFiles::RunFiles(const RunOptions& opt, const SceneConfig& c)
       checkpoint_(opt.out_dir.empty() ? "" : opt.out_dir + "/checkpoint.bin"),
       fingerprint_(scene_fingerprint(c)) {}
 
-bool RunFiles::open(LoopState& st, bool with_frames, const LoadModel& load_model) {
+RunFiles::Start RunFiles::open(LoopState& st, bool with_frames, const LoadModel& load_model) {
   bool resumed = false;
+  Start start = Start::fresh;
   if (opt_.resume && !checkpoint_.empty() && std::filesystem::exists(checkpoint_)) {
     ArchiveReader in(checkpoint_);
     std::string fp;
@@ -240,6 +242,24 @@ bool RunFiles::open(LoopState& st, bool with_frames, const LoadModel& load_model
     load_model(in);
     in.expect_end();
     resumed = true;
+    start = Start::resumed;
+  } else if (!opt_.branch_from.empty()) {
+    ArchiveReader in(opt_.branch_from);
+    std::string fp;
+    in.get(fp);
+    std::string refused;
+    for (const std::string& key : fingerprint_keys_differing(fp, fingerprint_))
+      if (!branch_may_differ_in(key)) refused += (refused.empty() ? "" : ", ") + key;
+    if (!refused.empty())
+      throw InputError("--branch-from", opt_.branch_from, "",
+                       "a branch may differ from its parent only in drive.strain, drive.warmup_strain, scene.seed, "
+                       "output.* and the numerical keys that leave the state's layout alone; this one differs in " +
+                           refused + " (" + fingerprint_difference(fp, fingerprint_) + ")");
+    LoopState parent;  // the parent's accumulators are not this run's
+    parent.load(in);
+    load_model(in);
+    in.expect_end();
+    start = Start::branched;
   }
   if (!opt_.out_dir.empty()) {
     std::filesystem::create_directories(opt_.out_dir);
@@ -271,7 +291,15 @@ bool RunFiles::open(LoopState& st, bool with_frames, const LoadModel& load_model
     }
   }
   start_ = last_checkpoint_ = std::chrono::steady_clock::now();
-  return resumed;
+  return start;
+}
+
+bool branch_may_differ_in(const std::string& key) {
+  static const char* const allowed[] = {"drive.strain",          "drive.warmup_strain", "scene.seed",
+                                        "numerics.dt",           "numerics.skin",       "numerics.dt_safety",
+                                        "numerics.implicit_tol", "numerics.threads",    "numerics.newton_tol",
+                                        "output.every",          "output.frames"};
+  return std::find(std::begin(allowed), std::end(allowed), key) != std::end(allowed);
 }
 
 void RunFiles::check_written(std::ofstream& f, const std::string& path, long step) {
@@ -296,25 +324,32 @@ void RunFiles::end_row(const LoopState& st, long n, double strain, bool more, co
                        : opt_.checkpoint_seconds > 0 &&
                              std::chrono::duration<double>(now - last_checkpoint_).count() > opt_.checkpoint_seconds;
   if (!checkpoint_.empty() && due && more) {
-    LoopState snap = st;
-    snap.n = n;
-    snap.strain_before = strain;
-    snap.elapsed_before += std::chrono::duration<double>(now - start_).count();
-    series.flush();
-    snap.ts_bytes = static_cast<std::uint64_t>(std::filesystem::file_size(opt_.out_dir + "/timeseries.csv"));
-    if (frames.is_open()) {
-      frames.flush();
-      snap.frames_bytes = static_cast<std::uint64_t>(std::filesystem::file_size(opt_.out_dir + "/frames.xyz"));
-    }
-    ArchiveWriter out(checkpoint_);
-    out.put(fingerprint_);
-    snap.save(out);
-    save_model(out);
-    out.close();  // atomic: a kill while writing leaves the previous checkpoint
+    write_state(checkpoint_, st, n, strain, save_model, now);
     last_checkpoint_ = now;
     rows_since_checkpoint_ = 0;
   }
+  if (!checkpoint_.empty() && opt_.keep_final_state && !more)
+    write_state(opt_.out_dir + "/final_state.bin", st, n, strain, save_model, now);
   if (opt_.stop_after_steps > 0 && n >= opt_.stop_after_steps) throw RunInterrupted(n);
+}
+
+void RunFiles::write_state(const std::string& path, const LoopState& st, long n, double strain,
+                           const SaveModel& save_model, std::chrono::steady_clock::time_point now) {
+  LoopState snap = st;
+  snap.n = n;
+  snap.strain_before = strain;
+  snap.elapsed_before += std::chrono::duration<double>(now - start_).count();
+  series.flush();
+  snap.ts_bytes = static_cast<std::uint64_t>(std::filesystem::file_size(opt_.out_dir + "/timeseries.csv"));
+  if (frames.is_open()) {
+    frames.flush();
+    snap.frames_bytes = static_cast<std::uint64_t>(std::filesystem::file_size(opt_.out_dir + "/frames.xyz"));
+  }
+  ArchiveWriter out(path);
+  out.put(fingerprint_);
+  snap.save(out);
+  save_model(out);
+  out.close();  // atomic: a kill while writing leaves the previous file
 }
 
 void RunFiles::finish(const RunSummary& s) {

@@ -21,6 +21,16 @@ struct RunOptions {
   // With `resume` a run continues from it and ends bit for bit as an
   // uninterrupted run would (the wall time aside).
   bool resume = false;
+  // Start from the state in this archive (another run's checkpoint.bin or
+  // final_state.bin) instead of the scene's initial state, when there is no
+  // checkpoint to resume: the run goes on for drive.strain from the parent's
+  // time, its warm-up counted from there. Its scene may differ from the
+  // parent's only in numerical choices (branch_may_differ_in,
+  // scene/run_series.hpp): two branches of one state compare those choices
+  // on the same trajectory.
+  std::string branch_from = {};
+  // Keep the state at the end (out_dir/final_state.bin), for branches.
+  bool keep_final_state = false;
   double checkpoint_seconds = 60;
   long checkpoint_every_rows = 0;
   // Tests: throw RunInterrupted after this step (fluid step of a coupled run), as a kill would stop the run.

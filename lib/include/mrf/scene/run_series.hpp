@@ -117,10 +117,11 @@ struct LoopState {
   long pair_evals = 0;
   double elapsed_before = 0;  // wall seconds of earlier sessions of this run
   std::uint64_t ts_bytes = 0, frames_bytes = 0;  // lengths of timeseries.csv and frames.xyz
+  double t_origin = 0;  // the model's time when this run began: 0, or the parent's time for a branch (s)
   template <class Archive, class Self>  // as StressSeries::serialize
   static void serialize(Archive& ar, Self& s) {
     ar.io(s.n, s.row_start, s.strain_before, s.se, s.max_overlap, s.pair_evals, s.elapsed_before, s.ts_bytes,
-          s.frames_bytes);
+          s.frames_bytes, s.t_origin);
   }
   void save(ArchiveWriter& a) const { serialize(a, *this); }
   void load(ArchiveReader& a) { serialize(a, *this); }
@@ -131,6 +132,13 @@ std::string scene_fingerprint(const SceneConfig& c);
 // Which scene keys two fingerprints disagree on, with both values ("drive.strain
 // 24 in the checkpoint, 12 now; ..."): what a refused resume names.
 std::string fingerprint_difference(const std::string& was, const std::string& now);
+// The keys two fingerprints disagree on ("(format)" when one comes from
+// another version of mrf).
+std::vector<std::string> fingerprint_keys_differing(const std::string& was, const std::string& now);
+// Whether a run may branch from another run's state when their scenes differ
+// in `key`: the run's length, the output and the numerical choices that leave
+// the state's layout alone (numerics.integrator and implicit_order do not).
+bool branch_may_differ_in(const std::string& key);
 // Its CRC-32 as 8 hex digits: summary.json's scene_id, by which a sweep
 // archive tells a result of this scene from one of an edited scene.
 std::string scene_id(const SceneConfig& c);
@@ -156,11 +164,19 @@ class RunFiles {
   // read the payload to its end. Nothing in out_dir changes before all of
   // this has succeeded. Opens timeseries.csv and, with
   // `with_frames`, frames.xyz: new, or cut back to the checkpoint and
-  // appended to. Returns whether the run resumed.
-  bool open(LoopState& st, bool with_frames, const LoadModel& load_model);
+  // appended to. Without a checkpoint to resume and with
+  // RunOptions::branch_from: reads that archive (another run's checkpoint or
+  // final state), refuses it (InputError on "--branch-from") if its scene
+  // differs in a key branch_may_differ_in does not allow, and loads only the
+  // model from it; `st` stays a new run's, its t_origin and row_start to be
+  // set to the model's time by the caller. Returns how the run starts.
+  enum class Start { fresh, resumed, branched };
+  Start open(LoopState& st, bool with_frames, const LoadModel& load_model);
   // At a row boundary after step n, at `strain`: writes a checkpoint of `st`
-  // at step n when one is due and the run goes on (`more`), then throws
-  // RunInterrupted when RunOptions::stop_after_steps is reached.
+  // at step n when one is due and the run goes on (`more`), or the final
+  // state (out_dir/final_state.bin, with RunOptions::keep_final_state) when
+  // it does not, then throws RunInterrupted when
+  // RunOptions::stop_after_steps is reached.
   void end_row(const LoopState& st, long n, double strain, bool more, const SaveModel& save_model);
   // The run is complete: summary.json (atomically), then the checkpoint is removed.
   void finish(const RunSummary& s);
@@ -171,6 +187,9 @@ class RunFiles {
  private:
   // flushes f and throws OutputError naming path and the system error if the write failed
   void check_written(std::ofstream& f, const std::string& path, long step);
+  // an archive of the fingerprint, `st` at step n and strain, and the model (atomically)
+  void write_state(const std::string& path, const LoopState& st, long n, double strain, const SaveModel& save_model,
+                   std::chrono::steady_clock::time_point now);
   RunOptions opt_;
   std::string checkpoint_, fingerprint_;
   std::chrono::steady_clock::time_point start_, last_checkpoint_;
