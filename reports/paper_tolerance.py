@@ -1,11 +1,12 @@
 #!/usr/bin/python3
 """The implicit tolerance on the paper cell: the rules fixed in advance.
 
-Reads the runs of experiments/sweeps/paper_tolerance.toml (model 1) and
-paper_tolerance_coupled.toml (model 3), archived in
-reports/study/paper/tolerance/points and tolerance_coupled/points
-(<model>/tol_<t>/mn_<Mn>_seed_<s>), and applies the rule written in those
-files before any of their runs:
+Reads the runs of experiments/sweeps/paper_tolerance.toml (model 1),
+paper_tolerance_coupled.toml (model 3) and experiments/branch_tolerance.txt
+(model 1 at Mn 0.1, branches of one state per seed: scripts/branch-tolerance),
+archived in reports/study/paper/tolerance/points, tolerance_coupled/points
+and tolerance_branch/points (<model>/tol_<t>/mn_<Mn>_seed_<s>), and applies
+the rule written in those files before any of their runs:
 per Mn and tolerance t, the seed-by-seed difference of the wall stress
 from the reference tolerance's run of the same seed, its mean b and
 standard error SE; t passes at an Mn if |b| + 2 SE <= T, T half the median
@@ -39,10 +40,11 @@ class Design:
     """One sweep of the rule: its name, archive folder under the paper folder, model, ladder (loosest
     first; the last is the reference), Mason numbers and seeds."""
 
-    def __init__(self, sweep, archive, model, tols, mason, seeds):
+    def __init__(self, sweep, archive, model, tols, mason, seeds, source=None):
         self.sweep, self.archive, self.model = sweep, archive, model
         self.tols, self.mason, self.seeds = tols, mason, seeds
         self.ref = tols[-1]
+        self.source = source or f"experiments/sweeps/{sweep}.toml"  # where the design and its rule are written
 
 
 DESIGNS = (
@@ -50,6 +52,9 @@ DESIGNS = (
            (1, 2, 3, 4, 5, 6)),
     Design("paper_tolerance_coupled", "tolerance_coupled/points", "demsph_dd", (1e-2, 2.5e-3, 6.25e-4), (1.0,),
            (1, 2, 3)),
+    # branches of one state per seed (scripts/branch-tolerance): "seed" is the parent
+    Design("branch_tolerance", "tolerance_branch/points", "dem_stokes", (1e-2, 2.5e-3, 6.25e-4), (0.1,),
+           (1, 2, 3, 4, 5, 6), source="experiments/branch_tolerance.txt"),
 )
 
 
@@ -114,7 +119,7 @@ def order_fit(rows, mn):
 
 def section(d, runs, rows, thresholds, chosen):
     """The markdown of one design."""
-    out = [f"## {d.model}: experiments/sweeps/{d.sweep}.toml", ""]
+    out = [f"## {d.model}: {d.source}", ""]
     if chosen == "incomplete":
         out += ["**Rule not yet evaluable**: runs are missing (below).", ""]
     elif chosen == "inconclusive":
