@@ -117,7 +117,7 @@ def order_fit(rows, mn):
     return q, math.exp(my - q * mx)
 
 
-def section(d, runs, rows, thresholds, chosen):
+def section(d, runs, rows, thresholds, chosen, points):
     """The markdown of one design."""
     out = [f"## {d.model}: {d.source}", ""]
     if chosen == "incomplete":
@@ -164,7 +164,28 @@ def section(d, runs, rows, thresholds, chosen):
                      for t in d.tols]
             out.append(f"| {s} | " + " | ".join(cells) + " |")
         out.append("")
+        out += block_table(d, points, mn)
     return out
+
+
+def block_table(d, points, mn):
+    """Where the runs keep blocks.csv (the branch design): each run's particle part in its 20-strain blocks,
+    to show whether the branches of one parent stay in one state."""
+    runs, edges = [], []
+    for s in d.seeds:
+        for t in d.tols:
+            path = os.path.join(points, d.model, f"tol_{t:g}", f"mn_{mn:g}_seed_{s}", "blocks.csv")
+            if os.path.exists(path):
+                with open(path) as f:
+                    blocks = [line.split(",") for line in f.read().splitlines()[1:]]
+                edges = max(edges, [f"{b[0]}-{b[1]}" for b in blocks], key=len)
+                runs.append((s, t, [float(b[2]) for b in blocks]))
+    if not runs:
+        return []
+    return (["Particle part (Pa) of each branch in 20-strain blocks of its own strain, beside the rule:", "",
+             "| parent | tolerance | " + " | ".join(edges) + " |", "|---:|---:|" + "---:|" * len(edges)] +
+            [f"| {s} | {t:g} | " + " | ".join(f"{v:.2f}" for v in vals) + " |" * (1 + len(edges) - len(vals))
+             for s, t, vals in runs] + [""])
 
 
 def main():
@@ -184,7 +205,7 @@ def main():
         points = os.path.join("out", "sweeps", d.sweep) if from_runs else os.path.join(paper, d.archive)
         runs, rows, thresholds = analyse(d, points)
         chosen = choose(d, rows)
-        out += section(d, runs, rows, thresholds, chosen)
+        out += section(d, runs, rows, thresholds, chosen, points)
         print(f"{d.sweep}: chosen {chosen}")
         for mn in d.mason:
             colour = next(colours)
