@@ -17,8 +17,9 @@ experiments/sweeps/paper_mn01_states.toml (Mn 0.1) and
 paper_model1_seeds.toml (the other Mn) into its headline points,
 and reports/paper_model1_seeds.py shows every seed's window
 (reports/study/paper/model1_seeds.md). reports/paper_tolerance.py applies
-the rules of experiments/sweeps/paper_tolerance.toml and
-paper_tolerance_coupled.toml to their runs (reports/study/paper/tolerance.md).
+the rules of experiments/sweeps/paper_tolerance.toml,
+paper_tolerance_coupled.toml and experiments/branch_tolerance.txt to their
+runs (reports/study/paper/tolerance.md).
 
 With --runs the eight sweeps are read from their run folders
 (out/sweeps/<sweep name>, laid out as an archive is) instead of the

@@ -215,8 +215,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   run->add_option("--branch-from", run_opt.branch_from,
                   "start from this state of another run (its checkpoint.bin or final_state.bin) unless OUT holds a "
-                  "checkpoint to resume; the scene may differ only in drive.strain, drive.warmup_strain, scene.seed, "
-                  "output.* and numerics.dt, skin, dt_safety, implicit_tol, newton_tol, threads")
+                  "checkpoint to resume; the scene may differ from the parent's only in numerical keys (a refused "
+                  "key is named; docs/study.md, Branches)")
       ->check(CLI::ExistingFile);
   run->add_flag("--keep-final-state", run_opt.keep_final_state,
                 "write OUT/final_state.bin at the end (for --branch-from)");
