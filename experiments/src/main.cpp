@@ -21,6 +21,7 @@
 #include "mrf/io/timeseries.hpp"
 #include "mrf/scene/build_model.hpp"
 #include "mrf/scene/run.hpp"
+#include "mrf/study/point_claim.hpp"
 #include "mrf/study/sweep.hpp"
 #include "mrf/version.hpp"
 
@@ -129,6 +130,7 @@ int sweep_command(const SweepArgs& a) {
                           : mrf::archive_entry_current(spec, p, a.archive)              ? "archived"
                           : stale_here                                                   ? "stale"
                           : std::filesystem::exists(dir / "failure.json")               ? "failed"
+                          : !mrf::point_claim_holder(dir).empty()                        ? "running"
                           : std::filesystem::exists(dir / "checkpoint.bin")             ? "started"
                           : archived_entry                                               ? "stale"
                                                                                          : "todo";
@@ -186,13 +188,12 @@ int sweep_command(const SweepArgs& a) {
   }
 #endif
   const mrf::SweepOutcome o = mrf::run_sweep(spec, out, opt);
-  if (a.point >= 0)
-    std::printf("sweep %s point %ld: %zu run, %zu skipped (finished before), %zu failed, %.1f s -> %s/sweep.csv\n",
-                a.file.c_str(), a.point, o.ran, o.skipped, o.failed, o.seconds, out.c_str());
-  else
-    std::printf("sweep %s rank %d/%d: %zu run, %zu skipped (finished before), %zu failed, %.1f s -> %s/sweep.csv\n",
-              a.file.c_str(), opt.rank.rank, opt.rank.size, o.ran, o.skipped, o.failed, o.seconds, out.c_str());
-  return o.failed > 0 ? 4 : 0;
+  const std::string who = a.point >= 0 ? "point " + std::to_string(a.point)
+                                       : "rank " + std::to_string(opt.rank.rank) + "/" + std::to_string(opt.rank.size);
+  std::printf("sweep %s %s: %zu run, %zu skipped (finished before), %zu failed, %zu left to other processes, %zu with "
+              "a refused checkpoint, %.1f s -> %s/sweep.csv\n",
+              a.file.c_str(), who.c_str(), o.ran, o.skipped, o.failed, o.elsewhere, o.refused, o.seconds, out.c_str());
+  return o.failed > 0 ? 4 : o.refused > 0 ? 3 : 0;
 }
 
 }  // namespace

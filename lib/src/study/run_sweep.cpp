@@ -17,6 +17,7 @@
 #include "mrf/scene/build_model.hpp"
 #include "mrf/scene/run.hpp"
 #include "mrf/scene/run_series.hpp"
+#include "mrf/study/point_claim.hpp"
 #include "mrf/study/sweep.hpp"
 #include "mrf/vec.hpp"
 
@@ -224,6 +225,21 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
   for (std::size_t k = 0; k < todo.size(); ++k) {
     const Todo& t = todo[k];
     const std::string dir = (std::filesystem::path(out_dir) / t.point->dir).string();
+    // Another process on this sweep output may run the point now, or have
+    // finished it since this one listed its points (point_claim.hpp).
+    const PointClaim claim(dir);
+    if (!claim.owned() || point_finished(dir)) {
+      if (std::isfinite(t.estimate)) left_estimated -= t.estimate;
+      if (!claim.owned()) {
+        ++outcome.elsewhere;
+        if (!opt.quiet)
+          std::fprintf(stderr, "mrf sweep: [%zu/%zu] %s is being run by %s: left to it\n", k + 1, todo.size(),
+                       t.point->dir.c_str(), claim.holder().c_str());
+      } else {
+        ++outcome.skipped;
+      }
+      continue;
+    }
     if (!opt.quiet)
       std::fprintf(stderr, "mrf sweep: [%zu/%zu] %s Mn=%g seed %llu -> %s\n", k + 1, todo.size(),
                    t.point->model.c_str(), t.point->mason, static_cast<unsigned long long>(t.point->seed), dir.c_str());
@@ -244,6 +260,15 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
       // a full disk or an unwritable folder: stop the sweep, and leave the
       // point resumable (no failure.json, which would mark it done)
       throw;
+    } catch (const CheckpointError& e) {
+      // a checkpoint of another format version (written by another build)
+      // or a damaged one: not the point's physics, so no failure.json; the
+      // point keeps its checkpoint and the sweep goes on with the others
+      ++outcome.refused;
+      std::fprintf(stderr,
+                   "mrf sweep: point %s not run: checkpoint refused: %s\n"
+                   "           (the folder is left as it is; deleting %s/checkpoint.bin runs the point from its start)\n",
+                   t.point->dir.c_str(), e.what(), dir.c_str());
     } catch (const std::runtime_error& e) {  // NumericalError, or an InputError only the run can see
       ++outcome.failed;
       std::filesystem::create_directories(dir);

@@ -124,6 +124,8 @@ struct SweepOptions {
 
 struct SweepOutcome {
   std::size_t ran = 0, skipped = 0, failed = 0;
+  std::size_t elsewhere = 0;  // points another live process was running (their claim held: point_claim.hpp)
+  std::size_t refused = 0;    // points whose checkpoint was refused (another format version, damaged): left as they are
   double estimated_seconds = 0;  // of this rank's unfinished points, before starting
   double seconds = 0;            // wall time spent
 };
@@ -158,8 +160,11 @@ PointEstimates estimate_points(const SweepSpec& spec, const std::vector<SweepPoi
 // (every scene is loaded and validated before the first run, and so is the
 // fluid of every SPH point against its box, as the coupled run checks it: an
 // input error stops the sweep at once, naming the point). A point that fails numerically leaves
-// failure.json with the message and the sweep goes on; a finished point is
-// skipped. Progress and an estimate of the time left go to stderr. At the
+// failure.json with the message and the sweep goes on; a point whose
+// checkpoint is refused (CheckpointError) is left as it is, said on stderr,
+// and the sweep goes on; a finished point is skipped, and so is a point
+// whose claim another live process holds (several processes may run one
+// sweep output side by side: point_claim.hpp). Progress and an estimate of the time left go to stderr. At the
 // end out_dir/sweep.csv is rewritten (atomically) from every finished point.
 SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const SweepOptions& opt);
 
