@@ -1,11 +1,13 @@
 #!/usr/bin/env python3
 """The sweep schedule measured (issue 15): a synthetic sweep whose point costs
-vary 30x, on 2 workers, scheduled two ways, side by side in one run:
+vary 30x, on 2 workers, scheduled three ways, side by side in one run:
 
   round-robin   `mrf sweep --rank 0 --ranks 2` and `--rank 1 --ranks 2`
                 started together (point index mod 2, the deal before MPI);
   master-worker `mpirun -n 3 mrf sweep` (rank 0 hands out the points, the
-                most expensive estimate first; ranks 1 and 2 run them).
+                most expensive estimate first; ranks 1 and 2 run them);
+  claims        `mrf sweep` started twice on one output (each process takes
+                the next point in grid order that nobody claims).
 
 The 8 points are model 3 (demsph_dd) on the small scene; points 0 and 2
 run 30x the strain of the other six, so that round-robin gives both long
@@ -63,11 +65,14 @@ def points(out):
 
 rr = work / "round_robin"
 mw = work / "master_worker"
+cl = work / "claims"
 base = [a.mrf, "sweep", str(sweep), "--quiet", "--checkpoint-every", "0"]
 t_rr = timed([base + ["--out", str(rr), "--rank", str(r), "--ranks", "2"] for r in (0, 1)])
 t_mw = timed([[a.mpiexec, "-n", "3", "--oversubscribe"] + base + ["--out", str(mw)]])
+t_cl = timed([base + ["--out", str(cl)] for _ in (0, 1)])
 rows = []
-for name, out, wall in (("round-robin (index mod 2)", rr, t_rr), ("master-worker (mpirun -n 3)", mw, t_mw)):
+for name, out, wall in (("round-robin (index mod 2)", rr, t_rr), ("master-worker (mpirun -n 3)", mw, t_mw),
+                        ("claims (two `mrf sweep` on one output)", cl, t_cl)):
     p = points(out)
     assert len(p) == 8, (name, p)
     total, largest = sum(p.values()), max(p.values())
