@@ -16,12 +16,13 @@ reports/study/paper/convergence/points. Model 1 takes the extra seeds of
 experiments/sweeps/paper_mn01_states.toml (Mn 0.1) and
 paper_model1_seeds.toml (the other Mn) into its headline points,
 and reports/paper_model1_seeds.py shows every seed's window
-(reports/study/paper/model1_seeds.md). reports/paper_tolerance.py applies
+(reports/study/paper/model1_seeds.md); model 3 at Mn 0.1 takes those of
+paper_mn01_coupled_seeds.toml. reports/paper_tolerance.py applies
 the rules of experiments/sweeps/paper_tolerance.toml,
 paper_tolerance_coupled.toml and experiments/branch_tolerance.txt to their
 runs (reports/study/paper/tolerance.md).
 
-With --runs the eight sweeps are read from their run folders
+With --runs the nine sweeps are read from their run folders
 (out/sweeps/<sweep name>, laid out as an archive is) instead of the
 committed archives: what `scripts/reproduce paper` does after running them
 from scratch.
@@ -91,9 +92,10 @@ def collect(mrf, toml, out, archive):
     subprocess.run([mrf, "criterion", out], check=True, stdout=subprocess.DEVNULL)
 
 
-# Extra-seed sweeps of the headline (model 1, seeds 4-8, each fixed in
-# advance): sweep name and committed archive.
-EXTRA_SEEDS = [("paper_mn01_states", "mn01_states/points"), ("paper_model1_seeds", "model1_seeds/points")]
+# Extra-seed sweeps of the headline (model 1, seeds 4-8; model 3 at Mn 0.1,
+# seeds 4-6; each fixed in advance): sweep name and committed archive.
+EXTRA_SEEDS = [("paper_mn01_states", "mn01_states/points"), ("paper_model1_seeds", "model1_seeds/points"),
+               ("paper_mn01_coupled_seeds", "mn01_coupled_seeds/points")]
 
 
 def merge_extra_seeds(mrf, toml, archive, out):
@@ -157,7 +159,7 @@ def main():
                 merged = 0
                 for extra, _ in EXTRA_SEEDS:
                     n = merge_extra_seeds(mrf, os.path.join(sweeps, extra + ".toml"), src[extra], out)
-                    print(f"{extra}: {n} runs of model 1 merged into the headline points")
+                    print(f"{extra}: {n} runs merged into the headline points")
                     merged += n
                 if merged:
                     subprocess.run([mrf, "criterion", out], check=True, stdout=subprocess.DEVNULL)

@@ -215,6 +215,19 @@ TEST(Sweep, KilledSweepResumesAndReproduces) {
                                                   (out / "nothing_here").string(), 1e6, "", {out.string()});
   ASSERT_TRUE(by_plain.calibrated[0]);
   EXPECT_DOUBLE_EQ(by_plain.seconds[0], read_json(p1 / "summary.json")["seconds_per_strain"].get<double>() * 0.6);
+  // more seeds of a finished point (none of them run yet): calibrated by the
+  // same model and Mn at another seed in the calibration folder, not by the
+  // particle-steps model; a Mn the folder lacks, by those (the nearest Mn)
+  const SweepSpec more_seeds = parse_sweep(
+      "[sweep]\nscene = \"small_dem_stokes.toml\"\nmodels = [\"dem_stokes\"]\nmason = [1.0, 2.0]\nseeds = [7, 8]\n"
+      "set = [\"drive.strain=0.9\", \"drive.warmup_strain=0.3\"]\n",
+      "tiny.toml", k_scenes);
+  const PointEstimates by_seed = estimate_points(more_seeds, sweep_points(more_seeds), (out / "nothing_here").string(),
+                                                 1e6, "", {out.string()});
+  for (std::size_t k = 0; k < 4; ++k) {  // Mn 1 and 2, seeds 7 and 8
+    ASSERT_TRUE(by_seed.calibrated[k]);
+    EXPECT_DOUBLE_EQ(by_seed.seconds[k], read_json(p1 / "summary.json")["seconds_per_strain"].get<double>() * 0.9);
+  }
   const SweepSpec short_one = parse_sweep(
       "[sweep]\nscene = \"small_dem_stokes.toml\"\nmodels = [\"dem_stokes\"]\nmason = [1.0]\nseeds = [3]\n"
       "set = [\"drive.strain=0.6\", \"drive.warmup_strain=0.2\"]\n",

@@ -124,6 +124,26 @@ PointEstimates estimate_points(const SweepSpec& spec, const std::vector<SweepPoi
           path = w / "summary.json";
           found = true;
         }
+      // then the same model (and variant) and Mn at another seed in a
+      // calibration folder, the first by folder name (a sweep of more seeds
+      // of a finished point, estimated before any of its runs)
+      const std::string name = std::filesystem::path(points[k].dir).filename().string();
+      const std::size_t seed_at = name.rfind("_seed_");
+      for (const std::string& d : calibrate_dirs) {
+        if (found || seed_at == std::string::npos) break;
+        const auto folder = std::filesystem::path(d) / std::filesystem::path(points[k].dir).parent_path();
+        const std::string prefix = name.substr(0, seed_at + 6);
+        std::error_code ec;
+        std::vector<std::filesystem::path> others;
+        for (const auto& e : std::filesystem::directory_iterator(folder, ec))
+          if (e.path().filename().string().rfind(prefix, 0) == 0 && std::filesystem::exists(e.path() / "summary.json"))
+            others.push_back(e.path() / "summary.json");
+        std::sort(others.begin(), others.end());
+        if (!others.empty()) {
+          path = others.front();
+          found = true;
+        }
+      }
       if (!found) continue;
     }
     try {

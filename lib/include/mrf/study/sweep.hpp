@@ -147,7 +147,9 @@ double estimate_point_seconds(const std::string& scene_path, const std::vector<s
 // the cost alone and never restored), the first that has the point, where
 // neither has it; for a point of a variant, the same model, Mn and seed
 // without the variant level there calibrates too (a convergence sweep
-// estimated from its own earlier runs, then from its base sweep).
+// estimated from its own earlier runs, then from its base sweep), and then
+// the same model, variant and Mn at another seed there (more seeds of a
+// finished point, estimated before any of them ran).
 struct PointEstimates {
   std::vector<double> seconds;
   std::vector<char> calibrated;
