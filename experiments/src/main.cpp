@@ -134,9 +134,16 @@ int sweep_command(const SweepArgs& a) {
                           : std::filesystem::exists(dir / "checkpoint.bin")             ? "started"
                           : archived_entry                                               ? "stale"
                                                                                          : "todo";
-      std::printf("%-5zu %-40s %-14s %-9g %-5llu %-9s %.3g%s\n", p.index, p.dir.c_str(), p.model.c_str(), p.mason,
+      std::string progress;  // a run under way: the strain of its last series row
+      if (std::string_view(state) == "started" || std::string_view(state) == "running") {
+        const double strain = mrf::load_scene(spec.scene_path, p.sets).config.strain;
+        char buf[96];
+        std::snprintf(buf, sizeof buf, "  (strain %.3g of %.3g)", mrf::point_strain_reached(dir.string()), strain);
+        progress = buf;
+      }
+      std::printf("%-5zu %-40s %-14s %-9g %-5llu %-9s %.3g%s%s\n", p.index, p.dir.c_str(), p.model.c_str(), p.mason,
                   static_cast<unsigned long long>(p.seed), state, est.seconds[p.index],
-                  est.calibrated[p.index] ? "" : " *");
+                  est.calibrated[p.index] ? "" : " *", progress.c_str());
     }
     return 0;
   }
@@ -155,12 +162,20 @@ int sweep_command(const SweepArgs& a) {
       };
       const bool finished = has(out, "summary.json") || mrf::archive_entry_current(spec, p, a.archive);
       const bool failed = !finished && has(out, "failure.json");
-      std::printf("%-40s estimated %.3g s%s%s\n", p.dir.c_str(), e, est.calibrated[p.index] ? "" : " *",
-                  finished ? " (finished)" : failed ? " (failed)" : "");
+      // a run under way (a checkpoint and series rows in --out) has only the rest of its strain to go
+      const std::string dir = (std::filesystem::path(out) / p.dir).string();
+      const double strain = finished || failed ? 0.0 : mrf::load_scene(spec.scene_path, p.sets).config.strain;
+      const double share = finished || failed || mrf::point_stale(spec, p, dir) ? 1.0 : mrf::point_fraction_left(dir, strain);
+      char started[96] = "";
+      if (share < 1.0)
+        std::snprintf(started, sizeof started, " (started: strain %.3g of %.3g, %.3g s left)",
+                      mrf::point_strain_reached(dir), strain, e * share);
+      std::printf("%-40s estimated %.3g s%s%s%s\n", p.dir.c_str(), e, est.calibrated[p.index] ? "" : " *",
+                  finished ? " (finished)" : failed ? " (failed)" : "", started);
       if (e == e) total += e;
       if (!finished && !failed) {
         ++to_run;
-        if (e == e) left += e;
+        if (e == e) left += e * share;
       }
       model_only += est.calibrated[p.index] ? 0 : 1;
     }

@@ -14,6 +14,11 @@
   2 of 2 to run, and point 0 is estimated by its own earlier run's seconds
   per strain unit times the new strain (not by its old wall time); --list
   calls it "stale".
+- A run under way (a checkpoint and series rows up to strain 0.05 of 0.2):
+  its line says how far it has come, the "to run" seconds count only the
+  rest of its strain (0.75 of its estimate), and --list says "started" with
+  its strain; without a checkpoint (a run that would start again) its whole
+  estimate counts.
 
 Usage: sweep_estimate_check.py MRF_BINARY SCENE WORKDIR
 """
@@ -96,4 +101,31 @@ assert list_states("--archive", str(archive)) == {p0: "stale", p1: "todo"}, list
 want = s0["seconds_per_strain"] * 0.4
 assert close(per[p0][0], want), f"stale point 0 estimated {per[p0][0]} s, want its own {s0['seconds_per_strain']} s per strain x 0.4"
 print(f"rule changed point 0's strain: 2 of 2 to run, point 0 at its own rate x new strain ({per[p0][0]:.3g} s)")
+
+# point 1 under way: a checkpoint (its content is the run's business) and series rows up to strain 0.05
+shutil.rmtree(out, ignore_errors=True)
+sweep.write_text(HEAD)
+subprocess.run([mrf, "sweep", str(sweep), "--out", str(out), "--point", "0", "--quiet"], check=True,
+               capture_output=True)
+rows = (out / p0 / "timeseries.csv").read_text().splitlines()
+kept = [rows[0]] + [r for r in rows[1:] if float(r.split(",")[1]) <= 0.05]
+reached = float(kept[-1].split(",")[1])
+assert len(kept) > 2 and reached > 0.02, kept
+(out / p1).mkdir(parents=True)
+(out / p1 / "timeseries.csv").write_text("\n".join(kept) + "\n")
+per, whole, n_run, n, total = estimate()
+assert (n_run, n) == (1, 2), (n_run, n)
+assert close(whole, per[p1][0]), "without a checkpoint the run starts again: its whole estimate is to run"
+(out / p1 / "checkpoint.bin").write_bytes(b"a run's checkpoint")
+text = subprocess.run([mrf, "sweep", str(sweep), "--out", str(out), "--estimate"], check=True, capture_output=True,
+                      text=True).stdout
+per, left, n_run, n, total = estimate()
+assert (n_run, n) == (1, 2), (n_run, n)
+assert close(left, per[p1][0] * (1 - reached / 0.2)), (left, per[p1][0], reached)
+assert f"started: strain {reached:.3g} of 0.2" in text, text
+listed = subprocess.run([mrf, "sweep", str(sweep), "--out", str(out), "--list"], check=True, capture_output=True,
+                        text=True).stdout
+line = next(ln for ln in listed.splitlines() if p1 in ln)
+assert line.split()[5] == "started" and f"(strain {reached:.3g} of 0.2)" in line, line
+print(f"point 1 under way at strain {reached:.3g} of 0.2: {left:.3g} s to run of its {per[p1][0]:.3g} s")
 print("SweepEstimate: ok")

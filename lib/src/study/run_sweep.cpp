@@ -219,6 +219,8 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
       } catch (const InputError&) {
         // not estimable (e.g. a time-step rule of a model the estimate does not know); run it anyway
       }
+    // a run under way resumes from its checkpoint: only the rest of its strain is to go
+    est *= point_fraction_left((std::filesystem::path(out_dir) / p.dir).string(), scene.config.strain);
     todo.push_back({&p, std::move(scene), est});
   }
   double known = 0;

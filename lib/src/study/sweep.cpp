@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -286,6 +287,33 @@ RankInfo rank_from_environment() {
 bool point_finished(const std::string& point_dir) {
   const std::filesystem::path d(point_dir);
   return std::filesystem::exists(d / "summary.json") || std::filesystem::exists(d / "failure.json");
+}
+
+double point_strain_reached(const std::string& point_dir) {
+  const std::filesystem::path d(point_dir);
+  if (!std::filesystem::exists(d / "checkpoint.bin")) return 0.0;
+  std::ifstream in(d / "timeseries.csv", std::ios::binary);
+  if (!in) return 0.0;
+  // the last complete line is in the file's last few kB (a row is ~200 bytes)
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg(), tail = std::min<std::streamoff>(size, 8192);
+  std::string text(static_cast<std::size_t>(tail), '\0');
+  in.seekg(size - tail);
+  in.read(text.data(), tail);
+  const std::size_t end = text.find_last_of('\n');
+  if (end == std::string::npos || end == 0) return 0.0;
+  const std::size_t begin = text.find_last_of('\n', end - 1);
+  if (begin == std::string::npos) return 0.0;  // the header alone (or a row longer than the tail)
+  const std::string row = text.substr(begin + 1, end - begin - 1);
+  const std::size_t comma = row.find(',');  // time_s,strain,...
+  if (comma == std::string::npos) return 0.0;
+  char* stop = nullptr;
+  const double strain = std::strtod(row.c_str() + comma + 1, &stop);
+  return stop != row.c_str() + comma + 1 && std::isfinite(strain) && strain > 0 ? strain : 0.0;
+}
+
+double point_fraction_left(const std::string& point_dir, double strain) {
+  return strain > 0 ? std::clamp(1.0 - point_strain_reached(point_dir) / strain, 0.0, 1.0) : 1.0;
 }
 
 std::string sweep_csv(const std::vector<SweepPoint>& points, const std::string& out_dir, const SweepSpec* spec) {

@@ -98,6 +98,16 @@ RankInfo rank_from_environment();
 // failure.json exists; delete the folder of a failed point to run it again.
 bool point_finished(const std::string& point_dir);
 
+// How far an unfinished point's run has come: the strain of the last row of
+// its timeseries.csv, 0 when it has none or no checkpoint.bin to resume from
+// (a run without one starts again from zero). Rows written after the last
+// checkpoint are counted, so this may be ahead of where a resumed run
+// restarts by up to one checkpoint interval.
+double point_strain_reached(const std::string& point_dir);
+// The share of a point's run still to go, 1 - reached / strain in [0, 1]:
+// what scales its estimate into the time left.
+double point_fraction_left(const std::string& point_dir, double strain);
+
 // sweep.csv text: one row per point of `points` that has a summary.json or a
 // failure.json under `out_dir`, with the DESIGN.md summary fields. With the
 // sweep's spec, a folder made for another scene (folder_scene_id differs
