@@ -12,7 +12,8 @@ usage: paper_study.py SWEEP_DIR OUT_DIR [--small reports/study/flow_curves.csv]
                       [--fixed-m-criterion reports/study/paper/fixed_m_criterion.json]
                       [--aqs-seeds headline_0.45,seed2,seed3]
                       [--first-runs reports/study/paper/first_runs]
-                      [--second-runs reports/study/paper/second_runs] [--note TEXT]
+                      [--second-runs reports/study/paper/second_runs]
+                      [--short-window-runs reports/study/paper/short_window_runs] [--note TEXT]
                       [--small-criterion reports/study/criterion_default.json]
                       [--reanalysed reports/study/paper/reanalysed.json]
                       [--convergence reports/study/paper/convergence.md]
@@ -33,7 +34,10 @@ window) with the standard error of their scatter.
 
 --first-runs, --second-runs: the summaries of the first and second runs of
 points re-run for steadiness (reports/study/paper/first_runs/, second_runs/),
-listed under the steadiness table with what their re-runs gave.
+listed under the steadiness table with what their re-runs gave;
+--short-window-runs: the coupled runs at Mn 1e-3 that session 34's
+one-window rule runs again over strain 16-48 (each point's seed mean before
+the rule against now is tabulated).
 --note: a paragraph under the title (what state the report is in).
 --reanalysed: `mrf reanalyse` records of archived runs (scripts/paper_interim.py
 writes them from the archive's window_series.csv files), for a post-hoc
@@ -476,6 +480,38 @@ def low_mn(argv, here, crit, phi, aqs_quote):
     return lines
 
 
+def one_window(rows, firsts, phi):
+    """Session 34's one-window rule for the coupled models at Mn 1e-3, as it
+    asked to be reported: each point's seed mean before it (each seed's
+    short-window run if it has one, else its second run, else its entry: the
+    runs session 33's tables used) against the entries now, and their windows."""
+    earlier = defaultdict(dict)
+    for f in firsts:
+        earlier[(f["model"], int(f["seed"]))][f["run_number"]] = f
+    lines = []
+    for k in ("demsph_stokes", "demsph_dd"):
+        now = [r for r in rows if r["model"] == k and abs(float(r["mason"]) - 1e-3) < 1e-9]
+        if not now:
+            continue
+        before = []
+        for r in now:
+            e = earlier[(k, int(r["seed"]))]
+            before.append(e.get("w") or e.get(2) or r)
+        def line(label, runs):
+            vals = [num(x, "stress_total") for x in runs]
+            wins = ", ".join(f"{num(x, 'warmup_strain'):g}-{num(x, 'strain'):g}" for x in runs)
+            m, sd = statistics.mean(vals), (statistics.stdev(vals) if len(vals) > 1 else float("nan"))
+            return (f"| {k} | {label} | {wins} | {m:.0f} ± {sd / math.sqrt(len(vals)):.0f} | "
+                    f"{statistics.mean(num(x, 'stress_fluid') for x in runs):.0f} |")
+        if not lines:
+            lines = ["", "One window at Mn 1e-3 (session 34's rule, fixed before its runs): the coupled points' seed means "
+                     "before it, in mixed windows, against their entries now (Pa; ± the seed scatter's standard error). "
+                     "The rule's runs replace the 4-12 ones as they finish.", "",
+                     "| model | runs | windows (strain) | total wall stress | fluid part |", "|---|---|---|---:|---:|"]
+        lines += [line("session 33's", before), line("now", now)]
+    return lines
+
+
 def sweep_cost(rows, firsts):
     """The wall time of the whole sweep: every run that counts, plus the
     first runs (summaries) that the steadiness re-runs replaced."""
@@ -646,7 +682,8 @@ def main(argv):
     # in first_runs/ and second_runs/ before a re-run overwrote the archive
     # entry), each marked with its run number.
     firsts = []
-    for number, key, sub in ((1, "--first-runs", "first_runs"), (2, "--second-runs", "second_runs")):
+    for number, key, sub in ((1, "--first-runs", "first_runs"), (2, "--second-runs", "second_runs"),
+                             ("w", "--short-window-runs", "short_window_runs")):
         folder = arg(argv, key, os.path.join(here, "study", "paper", sub))
         for dirpath, _, files in sorted(os.walk(folder)) if os.path.isdir(folder) else []:
             if "summary.json" in files:
@@ -655,11 +692,13 @@ def main(argv):
     if firsts:
         lines += ["", "Earlier runs of the points re-run for steadiness: run 1, the first run (re-run with strain and "
                   "warm-up doubled, session 21's rules); run 2, a re-run that failed again (run once more at 4x the "
-                  "first run's strain, session 27's rule); both at the end of experiments/sweeps/paper_realistic.toml. "
+                  "first run's strain, session 27's rule); run w, a coupled run at Mn 1e-3 that passed over strain 4-12, "
+                  "run again over 16-48 by session 34's one-window rule; all at the end of "
+                  "experiments/sweeps/paper_realistic.toml. "
                   "'in the table above' when that run is what the tables use (its re-run has not finished).", "",
                   "| model | Mn | seed | run | strain (warm-up) | drift z | MSER discard | steady | what the tables use now |",
                   "|---|---:|---:|---:|---:|---:|---:|---|---|"]
-        for f in sorted(firsts, key=lambda f: (ORDER.index(f["model"]), f["mason"], f["seed"], f["run_number"])):
+        for f in sorted(firsts, key=lambda f: (ORDER.index(f["model"]), f["mason"], f["seed"], str(f["run_number"]))):
             now = current.get((f["model"], float(f["mason"]), int(f["seed"])))
             if now is None:
                 state = "pending; not in the tables"
@@ -673,6 +712,7 @@ def main(argv):
                          f"{f['strain']:g} ({f['warmup_strain']:g}) | "
                          f"{f['stress_total_drift_z']:+.2f} | {f['steady_mser_discard_fraction']:.3f} | "
                          f"{'yes' if ok else '**no**'} | {state} |")
+    lines += one_window(rows, firsts, phi)
     lines += ["", "Cost: wall seconds per strain unit of each run, one thread, on a shared 2-core machine "
               "(the sweep ran at nice 19 beside other work: an upper bound, not a benchmark; "
               "reports/performance/model_ratios.md has the side-by-side ratios).", ""]
