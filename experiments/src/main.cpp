@@ -258,11 +258,17 @@ int main(int argc, char** argv) {
                  "restored from it): an estimate for a fresh run from the measured cost of an earlier one; "
                  "repeatable, the first folder that has a point calibrates it");
   sw->add_flag("--no-csv", sa.no_csv, "do not rewrite sweep.csv at the end (concurrent --point runs: --collect once)");
-  sw->add_option("--point", sa.point, "run point K of the grid alone (0-based, as --list numbers them)");
+  sw->add_option("--point", sa.point, "run point K of the grid alone (0-based, as --list numbers them)")
+      ->check(CLI::Validator(
+          [](const std::string& v) {
+            return !v.empty() && v[0] != '-' ? std::string() : "must be 0 or more (mrf sweep FILE --list numbers them)";
+          },
+          "K >= 0"));
   sw->add_option("--checkpoint-every", sa.checkpoint_seconds, "wall seconds between a point's checkpoints (0 = none)")
       ->capture_default_str();
-  sw->add_option("--rank", sa.rank, "run the share of rank R (0-based) of --ranks K; default: from mpirun, else all");
-  sw->add_option("--ranks", sa.ranks, "number of shares the grid is split into (round-robin)");
+  auto* ranks = sw->add_option("--ranks", sa.ranks, "number of shares the grid is split into (round-robin)");
+  sw->add_option("--rank", sa.rank, "run the share of rank R (0-based) of --ranks K; default: from mpirun, else all")
+      ->needs(ranks);
   auto* cr = app.add_subcommand("criterion", "flow-curve fits, deviation from model 3 and the model-1 verdict");
   std::string cr_path, cr_thresholds;
   cr->add_option("path", cr_path, "a sweep output directory (sweep.csv) or a dem_stokes run directory (summary.json)")

@@ -5,7 +5,9 @@
 #include "mrf/study/point_claim.hpp"
 
 #include <gtest/gtest.h>
+#include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -14,6 +16,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <thread>
 
 #include "mrf/study/sweep.hpp"
 
@@ -48,6 +51,24 @@ TEST(PointClaim, OneHolderAtATimeWithinAProcess) {
 
 // A claim held by another process, and dropped by the kernel when that
 // process is killed (no stale claim after a SIGKILL).
+// `--list` probes a claim with a shared lock for a moment: a sweep that
+// tries to claim the point just then waits it out instead of leaving the
+// point to whoever held it last.
+TEST(PointClaim, AMomentaryProbeDoesNotKeepTheClaim) {
+  const auto dir = fresh("mrf_test_claim_probe") / "point";
+  { const PointClaim first(dir); }  // the file exists, as after an earlier run
+  const int probe = ::open(point_claim_path(dir).c_str(), O_RDONLY);
+  ASSERT_GE(probe, 0);
+  ASSERT_EQ(::flock(probe, LOCK_SH | LOCK_NB), 0);
+  std::thread release([probe] {
+    ::usleep(50000);
+    ::close(probe);
+  });
+  const PointClaim claim(dir);
+  release.join();
+  EXPECT_TRUE(claim.owned());
+}
+
 TEST(PointClaim, HeldByAnotherProcessUntilItIsKilled) {
   const auto dir = fresh("mrf_test_claim_child") / "p";
   int ready[2];
@@ -101,6 +122,36 @@ TEST(PointClaim, SweepLeavesAClaimedPointToItsHolder) {
   EXPECT_EQ(o.failed, 0u);
   EXPECT_FALSE(point_finished((out / pts[0].dir).string()));
   EXPECT_TRUE(std::filesystem::exists(out / pts[1].dir / "summary.json"));
+}
+
+// A run of another scene in a claimed point's folder (the process running
+// it had other rules) is not set aside from under its holder: the folder
+// stays where the running process writes it. Once the claim is gone, the
+// next sweep sets it aside and runs the point.
+TEST(PointClaim, StaleFolderOfAClaimedPointStaysPut) {
+  const auto out = fresh("mrf_test_claim_stale");
+  const SweepSpec s = two_points();
+  const auto pts = sweep_points(s);
+  const auto dir = out / pts[0].dir;
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "summary.json") << R"({"scene_id": "0123abcd", "stress_total": 1.0})";
+  SweepOptions opt;
+  opt.quiet = true;
+  {
+    const PointClaim held(dir);
+    ASSERT_TRUE(held.owned());
+    const SweepOutcome o = run_sweep(s, out.string(), opt);
+    EXPECT_EQ(o.elsewhere, 1u);
+    EXPECT_EQ(o.ran, 1u);
+    EXPECT_TRUE(std::filesystem::exists(dir / "summary.json"));
+    EXPECT_FALSE(std::filesystem::exists(dir.string() + ".stale-0123abcd"));
+    EXPECT_TRUE(point_stale(s, pts[0], dir));
+  }
+  const SweepOutcome o = run_sweep(s, out.string(), opt);
+  EXPECT_EQ(o.ran, 1u);
+  EXPECT_TRUE(std::filesystem::exists(dir.string() + ".stale-0123abcd/summary.json"));
+  EXPECT_TRUE(point_finished(dir.string()));
+  EXPECT_FALSE(point_stale(s, pts[0], dir));
 }
 
 // A checkpoint of another format version (a build before or after this one

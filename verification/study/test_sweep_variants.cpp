@@ -86,6 +86,27 @@ TEST(SweepRules, SeedsSelectThePointsARuleLengthens) {
   }
 }
 
+// A sweep.set that is not an array is an error (it was dropped, and every
+// point ran the base scene's strain); two grid points that would share one
+// folder (a repeated seed, Mn equal to 4 digits) are an error naming it.
+TEST(SweepSpecErrors, SetNotAnArrayAndSharedFoldersAreRefused) {
+  const std::string head = "[sweep]\nscene = \"small_dem_stokes.toml\"\nmodels = [\"dem_stokes\"]\n";
+  const std::vector<std::pair<std::string, std::string>> bad{
+      {"mason = [0.01]\nseeds = [1]\nset = \"drive.strain=0.2\"\n", "sweep.set"},
+      {"mason = [0.01]\nseeds = [1, 2, 1]\n", "sweep"},
+      {"mason = [0.30001, 0.30002]\nseeds = [1]\n", "sweep"}};
+  for (const auto& [body, key] : bad) {
+    try {
+      parse_sweep(head + body, "e.toml", k_scenes);
+      ADD_FAILURE() << "expected InputError for " << body;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.key(), key) << e.what();
+    }
+  }
+  EXPECT_NO_THROW(parse_sweep(head + "mason = [0.3, 0.3002]\nseeds = [1, 2]\nset = [\"drive.strain=0.2\"]\n",
+                              "e.toml", k_scenes));
+}
+
 TEST(SweepRules, ARuleNamingVariantsRefinesThemAfterTheirOwnOverrides) {
   // a longer run of the "stiff" variant alone, at its Mn and for seed 2 (a
   // convergence variant that failed a steadiness test): its strain wins over

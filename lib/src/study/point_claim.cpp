@@ -35,14 +35,27 @@ std::string whoami() {
 
 }  // namespace
 
+std::filesystem::path point_claim_path(const std::filesystem::path& point_dir) {
+  return std::filesystem::path(point_dir.string() + ".claim");
+}
+
 PointClaim::PointClaim(const std::filesystem::path& point_dir) {
+  const std::filesystem::path file = point_claim_path(point_dir);
   std::error_code ec;
-  std::filesystem::create_directories(point_dir, ec);
-  const std::string path = (point_dir / "claim").string();
+  std::filesystem::create_directories(file.parent_path(), ec);
+  const std::string path = file.string();
   const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
   if (fd < 0) throw OutputError("cannot open the point's claim " + path + ": " + std::strerror(errno));
-  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
-    const int e = errno;
+  // A few tries before giving up: `--list` probes with a shared lock and a
+  // sweep sets a stale folder aside under a claim, each for a moment; a
+  // point that is being run is held for its whole run.
+  int e = 0;
+  for (int attempt = 0; attempt < 10; ++attempt) {
+    e = ::flock(fd, LOCK_EX | LOCK_NB) == 0 ? 0 : errno;
+    if (e != EWOULDBLOCK) break;
+    ::usleep(20000);
+  }
+  if (e != 0) {
     holder_ = read_all(fd);
     ::close(fd);
     if (e != EWOULDBLOCK) throw OutputError("cannot lock the point's claim " + path + ": " + std::strerror(e));
@@ -50,9 +63,9 @@ PointClaim::PointClaim(const std::filesystem::path& point_dir) {
   }
   const std::string me = whoami();
   if (::ftruncate(fd, 0) != 0 || ::pwrite(fd, me.data(), me.size(), 0) != static_cast<ssize_t>(me.size())) {
-    const int e = errno;
+    const int w = errno;
     ::close(fd);
-    throw OutputError("cannot write the point's claim " + path + ": " + std::strerror(e));
+    throw OutputError("cannot write the point's claim " + path + ": " + std::strerror(w));
   }
   fd_ = fd;
 }
@@ -62,7 +75,7 @@ PointClaim::~PointClaim() {
 }
 
 std::string point_claim_holder(const std::filesystem::path& point_dir) {
-  const std::string path = (point_dir / "claim").string();
+  const std::string path = point_claim_path(point_dir).string();
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) return "";
   std::string who;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <ios>
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -207,7 +208,9 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
   const PointEstimates calibrated = estimate_points(spec, points, out_dir, opt.cost_rate, opt.archive, opt.calibrate);
   for (std::size_t i : mine) {
     const SweepPoint& p = points[i];
-    if (point_finished((std::filesystem::path(out_dir) / p.dir).string())) {
+    const auto dir = std::filesystem::path(out_dir) / p.dir;
+    // (a folder of another scene still here is held by a running process)
+    if (point_finished(dir.string()) && !point_stale(spec, p, dir)) {
       ++outcome.skipped;
       continue;
     }
@@ -220,7 +223,7 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
         // not estimable (e.g. a time-step rule of a model the estimate does not know); run it anyway
       }
     // a run under way resumes from its checkpoint: only the rest of its strain is to go
-    est *= point_fraction_left((std::filesystem::path(out_dir) / p.dir).string(), scene.config.strain);
+    if (!point_stale(spec, p, dir)) est *= point_fraction_left(dir.string(), scene.config.strain);
     todo.push_back({&p, std::move(scene), est});
   }
   double known = 0;
@@ -250,6 +253,11 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
     // Another process on this sweep output may run the point now, or have
     // finished it since this one listed its points (point_claim.hpp).
     const PointClaim claim(dir);
+    if (claim.owned()) {  // what the start could not do while another process held the point
+      set_aside_stale(spec, {*t.point}, out_dir, opt.quiet, true);
+      if (!opt.archive.empty())
+        report_archive(restore_from_archive(spec, {*t.point}, out_dir, opt.archive, true), opt.archive, opt.quiet);
+    }
     if (!claim.owned() || point_finished(dir)) {
       if (std::isfinite(t.estimate)) left_estimated -= t.estimate;
       if (!claim.owned()) {
@@ -282,6 +290,10 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
       // a full disk or an unwritable folder: stop the sweep, and leave the
       // point resumable (no failure.json, which would mark it done)
       throw;
+    } catch (const std::filesystem::filesystem_error& e) {  // the same, from a file operation of the run
+      throw OutputError("point " + t.point->dir + ": " + e.what() + " (the sweep stops; the point stays resumable)");
+    } catch (const std::ios_base::failure& e) {
+      throw OutputError("point " + t.point->dir + ": " + e.what() + " (the sweep stops; the point stays resumable)");
     } catch (const CheckpointError& e) {
       // a checkpoint of another format version (written by another build)
       // or a damaged one: not the point's physics, so no failure.json; the

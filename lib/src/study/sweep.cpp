@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -166,7 +167,11 @@ SweepSpec parse_sweep(const std::string& toml_text, const std::string& source, c
   if (sw->get("mason") || !root.get("variant"))
     for (const auto& e : need_array(*sw, "mason", "sweep", source)) s.mason.push_back(positive_number(e, "sweep.mason", source));
   s.seeds = seeds(need_array(*sw, "seeds", "sweep", source), "sweep.seeds", source);
-  if (const auto* set = (*sw)["set"].as_array()) s.set = strings(*set, "sweep.set", source);
+  if (const toml::node* set = sw->get("set")) {
+    if (!set->as_array())
+      throw InputError("sweep.set", text_of(*set), where_of(*set, source), "expected an array of overrides");
+    s.set = strings(*set->as_array(), "sweep.set", source);
+  }
   if (const toml::node* rules = root.get("rule")) {
     const auto* arr = rules->as_array();
     if (!arr) throw InputError("rule", "", where_of(*rules, source), "expected [[rule]] tables");
@@ -209,6 +214,14 @@ SweepSpec parse_sweep(const std::string& toml_text, const std::string& source, c
     for (const auto& name : r.variants)
       if (std::none_of(s.variants.begin(), s.variants.end(), [&](const SweepVariant& v) { return v.name == name; }))
         throw InputError("rule.variants", "\"" + name + "\"", source, "not the name of a [[variant]] of this sweep");
+  // every point its own folder: a repeated seed, or two Mn that print alike
+  // to 4 digits, would have two points run in (and tabulated from) one
+  std::set<std::string> folders;
+  for (const SweepPoint& p : sweep_points(s))
+    if (!folders.insert(p.dir).second)
+      throw InputError("sweep", p.dir, source,
+                       "two points of the grid share this folder (a repeated seed, model or variant, or two Mason "
+                       "numbers equal to 4 significant digits)");
   return s;
 }
 

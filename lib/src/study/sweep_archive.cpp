@@ -2,6 +2,7 @@
 // sweep output, keyed by the scene_id of the scene that produced them.
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -12,6 +13,7 @@
 #include "mrf/io/timeseries.hpp"
 #include "mrf/scene/run_series.hpp"
 #include "mrf/io/toml_scene.hpp"
+#include "mrf/study/point_claim.hpp"
 #include "mrf/study/sweep.hpp"
 
 namespace mrf {
@@ -35,7 +37,7 @@ bool archive_entry_current(const SweepSpec& spec, const SweepPoint& p, const std
 }
 
 ArchiveSync restore_from_archive(const SweepSpec& spec, const std::vector<SweepPoint>& points,
-                                 const std::string& out_dir, const std::string& archive_dir) {
+                                 const std::string& out_dir, const std::string& archive_dir, bool claimed) {
   ArchiveSync sync;
   for (const SweepPoint& p : points) {
     const auto entry = std::filesystem::path(archive_dir) / p.dir / "summary.json";
@@ -56,6 +58,8 @@ ArchiveSync restore_from_archive(const SweepSpec& spec, const std::vector<SweepP
       sync.stale.push_back(p.dir);
       continue;
     }
+    const std::unique_ptr<PointClaim> claim = claimed ? nullptr : std::make_unique<PointClaim>(dir);
+    if (claim && !claim->owned()) continue;  // not under a run of another process
     const std::string text = read_text(entry);
     std::filesystem::create_directories(dir);
     std::filesystem::remove(dir / "checkpoint.bin");  // the point is finished: its partial run is moot
@@ -91,12 +95,24 @@ bool point_stale(const SweepSpec& spec, const SweepPoint& p, const std::filesyst
 }
 
 std::vector<std::string> set_aside_stale(const SweepSpec& spec, const std::vector<SweepPoint>& points,
-                                         const std::string& out_dir, bool quiet) {
+                                         const std::string& out_dir, bool quiet, bool claimed) {
   std::vector<std::string> moved;
   for (const SweepPoint& p : points) {
     const auto dir = std::filesystem::path(out_dir) / p.dir;
     const std::string want = scene_id(load_scene(spec.scene_path, p.sets).config);
     const std::string have = folder_scene_id(dir);
+    const auto mine = std::filesystem::path(dir.string() + ".stale-" + want);
+    const bool back = !std::filesystem::exists(dir / "summary.json") && std::filesystem::exists(mine / "summary.json");
+    if ((have.empty() || have == want) && !back) continue;
+    // Folders are moved only under the point's claim: a process running the
+    // point (with the other scene's rules) keeps its folder.
+    const std::unique_ptr<PointClaim> claim = claimed ? nullptr : std::make_unique<PointClaim>(dir);
+    if (claim && !claim->owned()) {
+      if (!quiet)
+        std::fprintf(stderr, "mrf sweep: %s is being run by %s: not set aside\n", dir.string().c_str(),
+                     claim->holder().c_str());
+      continue;
+    }
     if (!have.empty() && have != want) {
       // kept under the scene it was made for: a later run of that scene
       // replaces it, a return to that scene takes it back (below)
@@ -116,7 +132,6 @@ std::vector<std::string> set_aside_stale(const SweepSpec& spec, const std::vecto
                      aside.string().c_str());
     }
     // A finished run of this very scene set aside earlier comes back.
-    const auto mine = std::filesystem::path(dir.string() + ".stale-" + want);
     if (!std::filesystem::exists(dir / "summary.json") && std::filesystem::exists(mine / "summary.json") &&
         folder_scene_id(mine) == want) {
       std::error_code ec;

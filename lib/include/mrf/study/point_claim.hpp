@@ -4,8 +4,12 @@
 // runs a point only while it holds the point's claim, and passes over a
 // point another live process holds.
 //
-// The claim is an exclusive flock(2) on <point folder>/claim, taken without
-// waiting and held for as long as the PointClaim lives. The kernel drops it
+// The claim is an exclusive flock(2) on <point folder>.claim (beside the
+// folder, not in it: a sweep that sets a run of another scene aside renames
+// the folder, and does so only under the claim, so a running point's folder
+// is never moved from under it), taken without blocking (a few tries over
+// 0.2 s, for probes that hold it a moment) and held for as long as the
+// PointClaim lives. The kernel drops it
 // when its process ends however it ends (exit, SIGKILL, a crash), so a claim
 // is never left stale; a stopped process (SIGSTOP) still holds it. The file
 // stays (removing it while another process may have it open would let two
@@ -19,7 +23,8 @@ namespace mrf {
 
 class PointClaim {
  public:
-  // Creates the point folder if need be and tries to take its claim.
+  // Creates the folder the point's folder is in, if need be, and tries to
+  // take the point's claim.
   explicit PointClaim(const std::filesystem::path& point_dir);
   ~PointClaim();
   PointClaim(const PointClaim&) = delete;
@@ -38,5 +43,7 @@ class PointClaim {
 // Whether a live process holds the point's claim now, and who ("" if none);
 // takes nothing and creates nothing (for `--list`).
 std::string point_claim_holder(const std::filesystem::path& point_dir);
+// The claim's file: <point folder>.claim.
+std::filesystem::path point_claim_path(const std::filesystem::path& point_dir);
 
 }  // namespace mrf

@@ -198,8 +198,11 @@ struct ArchiveSync {
   // in the output whose summary.json they hold
   std::size_t series_added = 0;
 };
+// A folder is changed only under the point's claim (study/point_claim.hpp):
+// a point another process is running is left alone; `claimed`: the caller
+// holds the claims of `points` already.
 ArchiveSync restore_from_archive(const SweepSpec& spec, const std::vector<SweepPoint>& points,
-                                 const std::string& out_dir, const std::string& archive_dir);
+                                 const std::string& out_dir, const std::string& archive_dir, bool claimed = false);
 // Whether the archive holds a finished run of the point's scene as the
 // sweep file now defines it (a readable summary.json with its scene_id):
 // what a restore takes, --list calls archived and --estimate finished.
@@ -229,9 +232,12 @@ bool point_stale(const SweepSpec& spec, const SweepPoint& p, const std::filesyst
 // and a finished run of the point's own scene found under
 // <folder>.stale-<scene_id> (a sweep file edited and then reverted) comes
 // back instead of running again. A folder whose scene cannot be told (no
-// scene_id: an older mrf; a damaged checkpoint) is left alone. Returns the
-// point folders moved aside; says so on stderr unless quiet.
+// scene_id: an older mrf; a damaged checkpoint) is left alone, and so is
+// one whose point another process is running (its claim is held: the
+// folder is moved only under the claim; `claimed`: the caller holds the
+// claims of `points` already). Returns the point folders moved aside; says
+// so on stderr unless quiet.
 std::vector<std::string> set_aside_stale(const SweepSpec& spec, const std::vector<SweepPoint>& points,
-                                         const std::string& out_dir, bool quiet);
+                                         const std::string& out_dir, bool quiet, bool claimed = false);
 
 }  // namespace mrf
