@@ -5,10 +5,10 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <ios>
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <system_error>
 
 #include "mrf/box.hpp"
 #include "mrf/error.hpp"
@@ -290,9 +290,7 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
       // a full disk or an unwritable folder: stop the sweep, and leave the
       // point resumable (no failure.json, which would mark it done)
       throw;
-    } catch (const std::filesystem::filesystem_error& e) {  // the same, from a file operation of the run
-      throw OutputError("point " + t.point->dir + ": " + e.what() + " (the sweep stops; the point stays resumable)");
-    } catch (const std::ios_base::failure& e) {
+    } catch (const std::system_error& e) {  // the same from the system (filesystem_error, ios_base::failure)
       throw OutputError("point " + t.point->dir + ": " + e.what() + " (the sweep stops; the point stays resumable)");
     } catch (const CheckpointError& e) {
       // a checkpoint of another format version (written by another build)
