@@ -101,11 +101,15 @@ int sweep_command(const SweepArgs& a) {
     if (!std::filesystem::is_directory(d))
       throw mrf::InputError("--calibrate-from", d, "", "is not a folder (of finished points' summary.json)");
   opt.write_csv = !a.no_csv;
-  // --collect reads --out, so it restores the archive into it first (a run
-  // restores its own share, run_sweep); --list and --estimate write nothing
-  // and read the archive where it is
-  if (!a.archive.empty() && a.collect)
+  // --collect reads --out, so it first makes it what a run would find: a
+  // folder of another scene set aside (never a running point's: both under
+  // the point's claim) and the archive restored into it (a run does this for
+  // its own share, run_sweep); --list and --estimate write nothing and read
+  // the archive where it is
+  if (!a.archive.empty() && a.collect) {
+    mrf::set_aside_stale(spec, mrf::sweep_points(spec), out, a.quiet);
     mrf::report_archive(mrf::restore_from_archive(spec, mrf::sweep_points(spec), out, a.archive), a.archive, a.quiet);
+  }
   if (a.collect) {  // sweep.csv from the finished points, nothing run (while other ranks still work)
     const auto points = mrf::sweep_points(spec);
     const std::size_t done = mrf::write_sweep_csv(points, out, &spec);

@@ -19,6 +19,9 @@
   rest of its strain (0.75 of its estimate), and --list says "started" with
   its strain; without a checkpoint (a run that would start again) its whole
   estimate counts.
+- `--collect --archive` over an output that holds a finished run of
+  another scene (a rule since reverted) tabulates the archive's run of this
+  scene, and keeps the other aside.
 
 Usage: sweep_estimate_check.py MRF_BINARY SCENE WORKDIR
 """
@@ -128,4 +131,20 @@ listed = subprocess.run([mrf, "sweep", str(sweep), "--out", str(out), "--list"],
 line = next(ln for ln in listed.splitlines() if p1 in ln)
 assert line.split()[5] == "started" and f"(strain {reached:.3g} of 0.2)" in line, line
 print(f"point 1 under way at strain {reached:.3g} of 0.2: {left:.3g} s to run of its {per[p1][0]:.3g} s")
+
+# --collect --archive where --out holds a finished run of another scene (a rule since reverted) and the
+# archive a current one: the other scene's run is set aside and the archived one tabulated, as a run would
+out2 = work / "out2"
+sweep.write_text(HEAD + '\n[[rule]]\nmason_max = 0.5\nset = ["drive.strain=0.4", "drive.warmup_strain=0.1"]\n')
+subprocess.run([mrf, "sweep", str(sweep), "--out", str(out2), "--point", "0", "--quiet"], check=True,
+               capture_output=True)
+sweep.write_text(HEAD)
+subprocess.run([mrf, "sweep", str(sweep), "--out", str(out2), "--archive", str(archive), "--collect", "--quiet"],
+               check=True, capture_output=True)
+table = {r.split(",")[-1]: r.split(",") for r in (out2 / "sweep.csv").read_text().splitlines()[1:]}
+head = (out2 / "sweep.csv").read_text().splitlines()[0].split(",")
+row = table[p0]
+assert row[head.index("status")] == "ok" and float(row[head.index("strain")]) == 0.2, row
+assert list(out2.glob("dem_stokes/mn_0.3_seed_1.stale-*/summary.json")), "the other scene's run was not kept aside"
+print("--collect --archive: another scene's run in --out set aside, the archived run of this scene tabulated")
 print("SweepEstimate: ok")
