@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "mrf/io/toml_scene.hpp"
 #include "mrf/study/sweep.hpp"
 
 extern char** environ;
@@ -87,10 +88,20 @@ int mpi_sweep(const mrf::SweepSpec& spec, const std::string& out, const mrf::Swe
     if (!opt.archive.empty())
       mrf::report_archive(mrf::restore_from_archive(spec, points, out, opt.archive), opt.archive, opt.quiet);
     const mrf::PointEstimates est = mrf::estimate_points(spec, points, out, opt.cost_rate, opt.archive, opt.calibrate);
+    // what is left of each point to run: a run under way only the rest of its
+    // strain; a folder of another scene still here belongs to a running process
     std::vector<long> order;
-    for (const auto& p : points)
-      if (!mrf::point_finished((std::filesystem::path(out) / p.dir).string())) order.push_back(static_cast<long>(p.index));
-    const auto key = [&](long k) { return std::isfinite(est.seconds[k]) ? est.seconds[k] : -1.0; };
+    std::vector<double> left(points.size(), 0.0);
+    for (const auto& p : points) {
+      const auto dir = std::filesystem::path(out) / p.dir;
+      if (mrf::point_finished(dir.string()) && !mrf::point_stale(spec, p, dir)) continue;
+      order.push_back(static_cast<long>(p.index));
+      left[p.index] = mrf::point_stale(spec, p, dir)
+                          ? est.seconds[p.index]
+                          : est.seconds[p.index] * mrf::point_fraction_left(
+                                                       dir.string(), mrf::load_scene(spec.scene_path, p.sets).config.strain);
+    }
+    const auto key = [&](long k) { return std::isfinite(left[k]) ? left[k] : -1.0; };
     std::stable_sort(order.begin(), order.end(), [&](long a, long b) { return key(a) > key(b); });
     if (!opt.quiet)
       std::fprintf(stderr, "mrf sweep (MPI): %zu points, %zu to run on %d workers, the most expensive first\n",
