@@ -167,13 +167,12 @@ int sweep_command(const SweepArgs& a) {
       const bool finished = has(out, "summary.json") || mrf::archive_entry_current(spec, p, a.archive);
       const bool failed = !finished && has(out, "failure.json");
       // a run under way (a checkpoint and series rows in --out) has only the rest of its strain to go
-      const std::string dir = (std::filesystem::path(out) / p.dir).string();
-      const double strain = finished || failed ? 0.0 : mrf::load_scene(spec.scene_path, p.sets).config.strain;
-      const double share = finished || failed || mrf::point_stale(spec, p, dir) ? 1.0 : mrf::point_fraction_left(dir, strain);
+      const double share = finished || failed ? 1.0 : mrf::point_fraction_left(spec, p, out);
       char started[96] = "";
       if (share < 1.0)
         std::snprintf(started, sizeof started, " (started: strain %.3g of %.3g, %.3g s left)",
-                      mrf::point_strain_reached(dir), strain, e * share);
+                      mrf::point_strain_reached((std::filesystem::path(out) / p.dir).string()),
+                      mrf::load_scene(spec.scene_path, p.sets).config.strain, e * share);
       std::printf("%-40s estimated %.3g s%s%s%s\n", p.dir.c_str(), e, est.calibrated[p.index] ? "" : " *",
                   finished ? " (finished)" : failed ? " (failed)" : "", started);
       if (e == e) total += e;

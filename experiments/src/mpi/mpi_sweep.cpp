@@ -22,7 +22,6 @@
 #include <string>
 #include <vector>
 
-#include "mrf/io/toml_scene.hpp"
 #include "mrf/study/sweep.hpp"
 
 extern char** environ;
@@ -96,10 +95,7 @@ int mpi_sweep(const mrf::SweepSpec& spec, const std::string& out, const mrf::Swe
       const auto dir = std::filesystem::path(out) / p.dir;
       if (mrf::point_finished(dir.string()) && !mrf::point_stale(spec, p, dir)) continue;
       order.push_back(static_cast<long>(p.index));
-      left[p.index] = mrf::point_stale(spec, p, dir)
-                          ? est.seconds[p.index]
-                          : est.seconds[p.index] * mrf::point_fraction_left(
-                                                       dir.string(), mrf::load_scene(spec.scene_path, p.sets).config.strain);
+      left[p.index] = est.seconds[p.index] * mrf::point_fraction_left(spec, p, out);
     }
     const auto key = [&](long k) { return std::isfinite(left[k]) ? left[k] : -1.0; };
     std::stable_sort(order.begin(), order.end(), [&](long a, long b) { return key(a) > key(b); });

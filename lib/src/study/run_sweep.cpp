@@ -223,7 +223,7 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
         // not estimable (e.g. a time-step rule of a model the estimate does not know); run it anyway
       }
     // a run under way resumes from its checkpoint: only the rest of its strain is to go
-    if (!point_stale(spec, p, dir)) est *= point_fraction_left(dir.string(), scene.config.strain);
+    est *= point_fraction_left(spec, p, out_dir);
     todo.push_back({&p, std::move(scene), est});
   }
   double known = 0;

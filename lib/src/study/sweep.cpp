@@ -325,10 +325,6 @@ double point_strain_reached(const std::string& point_dir) {
   return stop != row.c_str() + comma + 1 && std::isfinite(strain) && strain > 0 ? strain : 0.0;
 }
 
-double point_fraction_left(const std::string& point_dir, double strain) {
-  return strain > 0 ? std::clamp(1.0 - point_strain_reached(point_dir) / strain, 0.0, 1.0) : 1.0;
-}
-
 std::string sweep_csv(const std::vector<SweepPoint>& points, const std::string& out_dir, const SweepSpec* spec) {
   static const char* numbers[] = {"shear_rate", "strain", "warmup_strain", "stress_total", "stress_total_err",
                                   "stress_total_drift_z", "steady_mser_discard_fraction", "stress_particles", "stress_particles_err", "stress_fluid",

@@ -1,5 +1,6 @@
 // The sweep archive: finished points' summary.json files kept apart from the
 // sweep output, keyed by the scene_id of the scene that produced them.
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -92,6 +93,13 @@ std::string folder_scene_id(const std::filesystem::path& dir) {
 bool point_stale(const SweepSpec& spec, const SweepPoint& p, const std::filesystem::path& dir) {
   const std::string have = folder_scene_id(dir);
   return !have.empty() && have != scene_id(load_scene(spec.scene_path, p.sets).config);
+}
+
+double point_fraction_left(const SweepSpec& spec, const SweepPoint& p, const std::string& out_dir) {
+  const auto dir = std::filesystem::path(out_dir) / p.dir;
+  if (point_stale(spec, p, dir)) return 1.0;  // another scene's run: this one starts from zero
+  const double strain = load_scene(spec.scene_path, p.sets).config.strain;
+  return strain > 0 ? std::clamp(1.0 - point_strain_reached(dir.string()) / strain, 0.0, 1.0) : 1.0;
 }
 
 std::vector<std::string> set_aside_stale(const SweepSpec& spec, const std::vector<SweepPoint>& points,

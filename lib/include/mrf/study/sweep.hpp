@@ -104,9 +104,6 @@ bool point_finished(const std::string& point_dir);
 // checkpoint are counted, so this may be ahead of where a resumed run
 // restarts by up to one checkpoint interval.
 double point_strain_reached(const std::string& point_dir);
-// The share of a point's run still to go, 1 - reached / strain in [0, 1]:
-// what scales its estimate into the time left.
-double point_fraction_left(const std::string& point_dir, double strain);
 
 // sweep.csv text: one row per point of `points` that has a summary.json or a
 // failure.json under `out_dir`, with the DESIGN.md summary fields. With the
@@ -239,5 +236,10 @@ bool point_stale(const SweepSpec& spec, const SweepPoint& p, const std::filesyst
 // so on stderr unless quiet.
 std::vector<std::string> set_aside_stale(const SweepSpec& spec, const std::vector<SweepPoint>& points,
                                          const std::string& out_dir, bool quiet, bool claimed = false);
+// The share of point p's run in out_dir still to go, 1 - reached / strain
+// in [0, 1] (point_strain_reached; 1 for a folder of another scene, whose
+// run this one does not continue): what scales its estimate into the time
+// left.
+double point_fraction_left(const SweepSpec& spec, const SweepPoint& p, const std::string& out_dir);
 
 }  // namespace mrf
