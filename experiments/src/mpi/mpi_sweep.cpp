@@ -92,8 +92,7 @@ int mpi_sweep(const mrf::SweepSpec& spec, const std::string& out, const mrf::Swe
     std::vector<long> order;
     std::vector<double> left(points.size(), 0.0);
     for (const auto& p : points) {
-      const auto dir = std::filesystem::path(out) / p.dir;
-      if (mrf::point_finished(dir.string()) && !mrf::point_stale(spec, p, dir)) continue;
+      if (mrf::point_finished(spec, p, out)) continue;
       order.push_back(static_cast<long>(p.index));
       left[p.index] = est.seconds[p.index] * mrf::point_fraction_left(spec, p, out);
     }

@@ -208,9 +208,7 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
   const PointEstimates calibrated = estimate_points(spec, points, out_dir, opt.cost_rate, opt.archive, opt.calibrate);
   for (std::size_t i : mine) {
     const SweepPoint& p = points[i];
-    const auto dir = std::filesystem::path(out_dir) / p.dir;
-    // (a folder of another scene still here is held by a running process)
-    if (point_finished(dir.string()) && !point_stale(spec, p, dir)) {
+    if (point_finished(spec, p, out_dir)) {
       ++outcome.skipped;
       continue;
     }

@@ -95,6 +95,11 @@ bool point_stale(const SweepSpec& spec, const SweepPoint& p, const std::filesyst
   return !have.empty() && have != scene_id(load_scene(spec.scene_path, p.sets).config);
 }
 
+bool point_finished(const SweepSpec& spec, const SweepPoint& p, const std::string& out_dir) {
+  const auto dir = std::filesystem::path(out_dir) / p.dir;
+  return point_finished(dir.string()) && !point_stale(spec, p, dir);
+}
+
 double point_fraction_left(const SweepSpec& spec, const SweepPoint& p, const std::string& out_dir) {
   const auto dir = std::filesystem::path(out_dir) / p.dir;
   if (point_stale(spec, p, dir)) return 1.0;  // another scene's run: this one starts from zero

@@ -236,6 +236,10 @@ bool point_stale(const SweepSpec& spec, const SweepPoint& p, const std::filesyst
 // so on stderr unless quiet.
 std::vector<std::string> set_aside_stale(const SweepSpec& spec, const std::vector<SweepPoint>& points,
                                          const std::string& out_dir, bool quiet, bool claimed = false);
+// Point p finished in out_dir for its scene as the sweep now defines it (a
+// finished folder of another scene, which a running process may still hold,
+// is not).
+bool point_finished(const SweepSpec& spec, const SweepPoint& p, const std::string& out_dir);
 // The share of point p's run in out_dir still to go, 1 - reached / strain
 // in [0, 1] (point_strain_reached; 1 for a folder of another scene, whose
 // run this one does not continue): what scales its estimate into the time
