@@ -30,6 +30,28 @@ LoadedScene scene(const std::string& integrator, double mason = 1.0, int frames 
                               "numerics.integrator=\"" + integrator + "\"", "output.frames=" + std::to_string(frames)});
 }
 
+// The loop state a checkpoint holds (after the scene's fingerprint).
+LoopState checkpointed_loop(const std::filesystem::path& path) {
+  ArchiveReader in(path.string());
+  std::string fingerprint;
+  in.get(fingerprint);
+  LoopState st;
+  st.load(in);
+  return st;
+}
+
+// Run times: CPU seconds are counted (one thread: at most the wall time) and
+// a resumed run's include its first session's, as its wall seconds do.
+void check_run_times(const RunSummary& whole, const RunSummary& resumed, const LoopState& first) {
+  ASSERT_EQ(whole.threads, 1);
+  EXPECT_GT(whole.cpu_seconds, 0.0);
+  EXPECT_LE(whole.cpu_seconds, whole.wall_seconds * 1.05 + 0.02);
+  EXPECT_GT(first.cpu_before, 0.0);
+  EXPECT_GT(first.elapsed_before, 0.0);
+  EXPECT_GE(resumed.cpu_seconds, first.cpu_before);
+  EXPECT_GE(resumed.wall_seconds, first.elapsed_before);
+}
+
 void check_resume_reproduces(const std::string& integrator) {
   const auto base = std::filesystem::temp_directory_path() / ("mrf_ckpt_" + integrator);
   std::filesystem::remove_all(base);
@@ -47,9 +69,11 @@ void check_resume_reproduces(const std::string& integrator) {
   ASSERT_TRUE(std::filesystem::exists(base / "cut/checkpoint.bin"));
   EXPECT_FALSE(std::filesystem::exists(base / "cut/summary.json"));
 
+  const LoopState first = checkpointed_loop(base / "cut/checkpoint.bin");
   cut.stop_after_steps = 0;
   cut.resume = true;
   const RunSummary b = run_scene(scene(integrator), cut);
+  check_run_times(a, b, first);
   EXPECT_EQ(b.stress_total.mean, a.stress_total.mean);
   EXPECT_EQ(b.stress_total.err, a.stress_total.err);
   EXPECT_EQ(b.stress_virial.mean, a.stress_virial.mean);
@@ -171,9 +195,11 @@ void check_coupled_resume_reproduces(const std::string& model, int frames, doubl
   ts[0] = 'T';
   std::ofstream(base / "cut/timeseries.csv", std::ios::binary) << ts;
 
+  const LoopState first = checkpointed_loop(base / "cut/checkpoint.bin");
   cut.stop_after_steps = 0;
   cut.resume = true;
   const RunSummary b = run_scene(coupled_scene(model, mason, frames, integrator), cut);
+  check_run_times(a, b, first);
   EXPECT_EQ(b.steps, a.steps);
   EXPECT_EQ(b.stress_total.mean, a.stress_total.mean);
   EXPECT_EQ(b.stress_total.err, a.stress_total.err);

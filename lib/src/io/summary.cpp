@@ -47,6 +47,7 @@ std::string summary_json(const RunSummary& s) {
   j["steps"] = s.steps;
   j["neighbor_builds"] = s.neighbor_builds;
   j["wall_seconds"] = s.wall_seconds;
+  j["cpu_seconds"] = s.cpu_seconds;
   j["particle_steps_per_second"] = s.particle_steps_per_second;
   j["pair_evaluations_per_second"] = s.pair_evaluations_per_second;
   j["threads"] = s.threads;

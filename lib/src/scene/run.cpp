@@ -72,7 +72,9 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
                    el * (c.strain - strain) / (strain - st.strain_before));
     }
   }
-  s.wall_seconds = st.elapsed_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const RunFiles::Elapsed elapsed = files.elapsed(st);
+  s.wall_seconds = elapsed.wall;
+  s.cpu_seconds = elapsed.cpu;
   s.steps = n;
   if (!opt.quiet) std::fprintf(stderr, "\r  done: %ld steps in %.1f s%40s\n", n, s.wall_seconds, "");
   st.se.finish(s);

@@ -2,6 +2,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <ctime>
 #include <sstream>
 
 #include <omp.h>
@@ -29,6 +30,12 @@ namespace {
 Measurement measure(const std::vector<double>& v) {
   const BlockAverage b = block_average(v);
   return {b.mean, b.sem, b.drift_z, b.independent_samples};
+}
+
+double process_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
 }  // namespace
@@ -291,7 +298,13 @@ RunFiles::Start RunFiles::open(LoopState& st, bool with_frames, const LoadModel&
     }
   }
   start_ = last_checkpoint_ = std::chrono::steady_clock::now();
+  cpu_start_ = process_cpu_seconds();
   return start;
+}
+
+RunFiles::Elapsed RunFiles::elapsed(const LoopState& st) const {
+  return {st.elapsed_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(),
+          st.cpu_before + process_cpu_seconds() - cpu_start_};
 }
 
 bool branch_may_differ_in(const std::string& key) {
@@ -339,6 +352,7 @@ void RunFiles::write_state(const std::string& path, const LoopState& st, long n,
   snap.n = n;
   snap.strain_before = strain;
   snap.elapsed_before += std::chrono::duration<double>(now - start_).count();
+  snap.cpu_before += process_cpu_seconds() - cpu_start_;
   series.flush();
   snap.ts_bytes = static_cast<std::uint64_t>(std::filesystem::file_size(opt_.out_dir + "/timeseries.csv"));
   if (frames.is_open()) {

@@ -335,7 +335,7 @@ std::string sweep_csv(const std::vector<SweepPoint>& points, const std::string& 
                                   "magnetization", "youngs_modulus", "viscosity", "fluid_density", "gap", "radius",
                                   "spanning_fraction", "sph_h", "implicit_newton_iterations", "implicit_linear_iterations",
                                   "error_estimate_version", "stress_total_independent_samples",
-                                  "stress_particles_drift_z", "stress_particles_independent_samples"};
+                                  "stress_particles_drift_z", "stress_particles_independent_samples", "cpu_seconds"};
   std::ostringstream csv;
   csv.precision(10);
   csv << "model,mason,seed,status";

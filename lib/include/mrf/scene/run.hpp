@@ -54,6 +54,7 @@ struct RunSummary {
   double stress_fluid = 0;
   long n_particles = 0, n_wall = 0, n_fluid = 0, steps = 0, neighbor_builds = 0;
   double wall_seconds = 0, particle_steps_per_second = 0, pair_evaluations_per_second = 0;
+  double cpu_seconds = 0;  // the process's CPU time over the run (all threads, every session of a resumed run)
   double stokes_number = 0, reynolds_number = 0, max_overlap_over_radius = 0;
   double youngs_modulus = 0, density = 0, magnetization = 0, volume_fraction = 0;
   double viscosity = 0, fluid_density = 0;  // carrier fluid: Pa s, kg/m^3

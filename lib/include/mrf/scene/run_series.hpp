@@ -116,12 +116,13 @@ struct LoopState {
   double max_overlap = 0;
   long pair_evals = 0;
   double elapsed_before = 0;  // wall seconds of earlier sessions of this run
+  double cpu_before = 0;      // CPU seconds (all threads) of earlier sessions of this run
   std::uint64_t ts_bytes = 0, frames_bytes = 0;  // lengths of timeseries.csv and frames.xyz
   double t_origin = 0;  // the model's time when this run began: 0, or the parent's time for a branch (s)
   template <class Archive, class Self>  // as StressSeries::serialize
   static void serialize(Archive& ar, Self& s) {
-    ar.io(s.n, s.row_start, s.strain_before, s.se, s.max_overlap, s.pair_evals, s.elapsed_before, s.ts_bytes,
-          s.frames_bytes, s.t_origin);
+    ar.io(s.n, s.row_start, s.strain_before, s.se, s.max_overlap, s.pair_evals, s.elapsed_before, s.cpu_before,
+          s.ts_bytes, s.frames_bytes, s.t_origin);
   }
   void save(ArchiveWriter& a) const { serialize(a, *this); }
   void load(ArchiveReader& a) { serialize(a, *this); }
@@ -180,6 +181,14 @@ class RunFiles {
   void end_row(const LoopState& st, long n, double strain, bool more, const SaveModel& save_model);
   // The run is complete: summary.json (atomically), then the checkpoint is removed.
   void finish(const RunSummary& s);
+  // Wall and CPU seconds of this run up to now, over every session of a
+  // resumed run (`st` carries the earlier sessions'). CPU time is the
+  // process's, all threads: unlike wall time it leaves out a stopped process
+  // (SIGSTOP) and the other jobs that share its cores.
+  struct Elapsed {
+    double wall = 0, cpu = 0;
+  };
+  Elapsed elapsed(const LoopState& st) const;
   const std::string& checkpoint() const { return checkpoint_; }
 
   std::ofstream series, frames;  // open when out_dir is set (frames when asked for)
@@ -191,6 +200,7 @@ class RunFiles {
   void write_state(const std::string& path, const LoopState& st, long n, double strain, const SaveModel& save_model,
                    std::chrono::steady_clock::time_point now);
   RunOptions opt_;
+  double cpu_start_ = 0;  // the process's CPU seconds when this session began
   std::string checkpoint_, fingerprint_;
   std::chrono::steady_clock::time_point start_, last_checkpoint_;
   long rows_since_checkpoint_ = 0;
