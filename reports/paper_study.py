@@ -523,10 +523,14 @@ def sweep_cost(rows, firsts):
     firsts = [f for f in firsts if current.get((f["model"], float(f["mason"]), int(f["seed"]))) not in (None, f["strain"])]
     first = sum(f.get("wall_seconds", 0.0) for f in firsts)
     total = sum(per.values()) + first
+    timed = [r for r in rows if num(r, "cpu_seconds") > 0]  # runs of checkpoint format 10 on record their CPU time
+    cpu = (f" CPU time, which leaves out pauses and the other jobs on the cores, is on record for {len(timed)} of the "
+           f"runs counted: {sum(num(r, 'cpu_seconds') for r in timed) / 3600:.2f} core-hours against their "
+           f"{sum(num(r, 'wall_seconds') for r in timed) / 3600:.2f} h of wall time." if timed else "")
     return ["Whole-sweep wall time (one thread per run, summed over runs; shared machine, an upper bound): "
             + ", ".join(f"{k} {per[k] / 3600:.1f} h" for k in ORDER if k in per)
             + f", the earlier runs replaced by re-runs {first / 3600:.1f} h; **{total / 3600:.1f} core-hours** in all "
-            f"({len(rows)} runs counted, {len(firsts)} replaced).", ""]
+            f"({len(rows)} runs counted, {len(firsts)} replaced)." + cpu, ""]
 
 
 def main(argv):
