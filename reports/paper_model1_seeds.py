@@ -75,12 +75,31 @@ def is_steady(s):
     return abs(s["stress_total_drift_z"]) < 3 and s["steady_mser_discard_fraction"] < 0.2
 
 
-def model3_mn01(folders):
+def model3_mn01(folders, paper):
     """Model 3 at Mn 0.1: each seed's run and the seed standard deviation of seeds 1-3 against all, as
-    experiments/sweeps/paper_mn01_coupled_seeds.toml asked to be reported beside its point."""
+    experiments/sweeps/paper_mn01_coupled_seeds.toml asked to be reported beside its point, and each kept
+    window's total wall stress in 10-strain bins (model3_mn01_windows.png)."""
     ss = summaries(folders, 0.1, "demsph_dd")
     if not ss:
         return []
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    missing = []
+    for seed, d in run_dirs(folders, 0.1, "demsph_dd"):
+        s = json.load(open(os.path.join(d, "summary.json")))
+        if not (os.path.exists(os.path.join(d, "window_series.csv")) or os.path.exists(os.path.join(d, "timeseries.csv"))):
+            missing.append(str(seed))
+            continue
+        rows = window_rows(d, s["warmup_strain"])
+        strain = [float(r["strain"]) for r in rows]
+        edges, fine = bins(strain, [float(r["stress_total_Pa"]) for r in rows], s["warmup_strain"], s["strain"], 10.0)
+        ax.plot([0.5 * (a + b) for a, b in zip(edges[:-1], edges[1:])], fine, "o-", ms=3, label=f"seed {seed}")
+    ax.set_xlabel("strain")
+    ax.set_ylabel("total wall stress (Pa), 10-strain bins")
+    ax.set_title("Model 3, Mn 0.1, paper cell: the averaging window of each seed")
+    ax.legend(fontsize=7, ncol=2)
+    fig.tight_layout()
+    fig.savefig(os.path.join(paper, "model3_mn01_windows.png"), dpi=90)
+    plt.close(fig)
     lines = ["## Model 3 at Mn 0.1: three seeds against six", "",
              "Seeds 1-3 from the headline sweep (their last runs), seeds 4-6 from "
              "`experiments/sweeps/paper_mn01_coupled_seeds.toml` (200 strain units, 100 of warm-up; fixed in "
@@ -105,6 +124,10 @@ def model3_mn01(folders):
                      f"{within:.2f} Pa).")
     if len(ss) < 6:
         lines.append(f"- {6 - len(ss)} of the design's seeds still running or queued.")
+    lines += ["", "![total wall stress per run](model3_mn01_windows.png)", ""]
+    if missing:
+        lines.append(f"Not in the figure: seed(s) {', '.join(missing)}, whose runs predate the archived windows "
+                     "(window_series.csv).")
     return lines + [""]
 
 
@@ -183,7 +206,7 @@ def main():
         lines.append(f"| {mn:g} | {len(ss)} | {sum(tot) / len(tot):.4g} | {sd3} | {sdall} | {err:.2g} | "
                      f"{', '.join(bad) if bad else 'none'} |")
     lines.append("")
-    lines += model3_mn01(folders)
+    lines += model3_mn01(folders, paper)
     ax.set_xlabel("strain")
     ax.set_ylabel("particle wall stress (Pa), 10-strain bins")
     ax.set_title("Model 1, Mn 0.1, paper cell: the averaging window of each seed")
