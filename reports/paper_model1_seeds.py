@@ -40,6 +40,64 @@ FOLDERS = (("points", "paper_realistic"), ("mn01_states/points", "paper_mn01_sta
            ("model1_seeds/points", "paper_model1_seeds"), ("mn01_coupled_seeds/points", "paper_mn01_coupled_seeds"))
 
 
+# the long runs of model 3 at Mn 0.1 (experiments/sweeps/paper_mn01_long.toml, session 35): shown beside
+# the point by the reading fixed in that file, never merged into it
+LONG = ("mn01_long/points", "paper_mn01_long")
+
+
+def combined(values, errors):
+    """Seed mean and its error as the point's: max(combined within-run error, seed scatter / sqrt(n))."""
+    n = len(values)
+    within = math.sqrt(sum(e * e for e in errors)) / n
+    return statistics.mean(values), max(within, statistics.stdev(values) / math.sqrt(n) if n > 1 else 0.0)
+
+
+def model3_long(paper, from_runs, six, model1):
+    """The reading of experiments/sweeps/paper_mn01_long.toml, as fixed there before its runs: L (the long
+    runs' window mean) against P (the six-seed point); if P - L > 2 combined standard errors, model 3 at
+    Mn 0.1 is not converged in strain at the design's windows, and D_1 = tau_1 / L - 1 is given beside."""
+    folder = os.path.join("out", "sweeps", LONG[1]) if from_runs else os.path.join(paper, LONG[0])
+    long = [(seed, d, json.load(open(os.path.join(d, "summary.json")))) for seed, d in run_dirs([folder], 0.1, "demsph_dd")]
+    lines = ["### Where model 3 settles at Mn 0.1: the long runs", "",
+             "experiments/sweeps/paper_mn01_long.toml (fixed before its runs, session 35): seeds 7 and 8, 800 strain "
+             "units with 400 of warm-up; their reading is in that file."]
+    if not long:
+        return lines + ["", "Not run yet.", ""]
+    lines += ["", "| seed | total over 400-800 (Pa) | drift z | MSER-5 | last two 200-strain halves: difference "
+              "(own SE) | 50-strain bins (Pa) |", "|---|---|---|---|---|---|"]
+    for seed, d, s in long:
+        rows = window_rows(d, s["warmup_strain"])
+        strain = [float(r["strain"]) for r in rows]
+        total = [float(r["stress_total_Pa"]) for r in rows]
+        lo, hi = s["warmup_strain"], s["strain"]
+        _, blocks = bins(strain, total, lo, hi, 50.0)
+        _, halves = bins(strain, total, lo, hi, (hi - lo) / 2)
+        # each half holds half the samples: its error is the window's times sqrt 2
+        diff = (halves[1] - halves[0]) / (2.0 * s["stress_total_err"]) if s["stress_total_err"] > 0 else float("nan")
+        lines.append(f"| {seed} | {s['stress_total']:.2f} ± {s['stress_total_err']:.2f} | "
+                     f"{s['stress_total_drift_z']:+.2f} | {s['steady_mser_discard_fraction']:.3f} | {diff:+.2f} | "
+                     + ", ".join(f"{b:.1f}" for b in blocks) + " |")
+    L, eL = combined([s["stress_total"] for _, _, s in long], [s["stress_total_err"] for _, _, s in long])
+    P, eP = combined([s["stress_total"] for s in six], [s["stress_total_err"] for s in six])
+    t1, e1 = combined([s["stress_total"] for s in model1], [s["stress_total_err"] for s in model1])
+    z = (P - L) / math.hypot(eP, eL)
+    lines += ["", f"L = {L:.2f} ± {eL:.2f} Pa ({len(long)} of 2 runs); P = {P:.2f} ± {eP:.2f} Pa (the six seeds); "
+              f"P - L = {P - L:+.2f} Pa = {z:+.2f} combined standard errors."]
+    if len(long) < 2:
+        lines.append("One of the two runs is still to come: the reading waits for both.")
+    elif z > 2:
+        d1 = t1 / L - 1
+        ed1 = (t1 / L) * math.hypot(e1 / t1, eL / L)
+        inside = d1 - 2 * ed1 <= -0.27 and d1 + 2 * ed1 >= -0.68
+        lines.append(f"By the reading fixed in advance: **model 3 at Mn 0.1 is not converged in strain** at the design's "
+                     f"windows. The point stays P; beside it, D_1 from the long runs = tau_1 / L - 1 = {d1:+.3f} ± "
+                     f"{ed1:.3f} (tau_1 = {t1:.2f} ± {e1:.2f} Pa, model 1's {len(model1)} seeds): "
+                     + ("inside" if inside else "**outside**") + " the claim's bound [-0.68, -0.27] to 2 standard errors.")
+    else:
+        lines.append("By the reading fixed in advance: P stands; L is shown beside it.")
+    return lines + [""]
+
+
 def roots(paper, from_runs):
     return [os.path.join("out", "sweeps", sweep) if from_runs else os.path.join(paper, archive)
             for archive, sweep in FOLDERS]
@@ -75,7 +133,7 @@ def is_steady(s):
     return abs(s["stress_total_drift_z"]) < 3 and s["steady_mser_discard_fraction"] < 0.2
 
 
-def model3_mn01(folders, paper):
+def model3_mn01(folders, paper, from_runs=False):
     """Model 3 at Mn 0.1: each seed's run and the seed standard deviation of seeds 1-3 against all, as
     experiments/sweeps/paper_mn01_coupled_seeds.toml asked to be reported beside its point, and each kept
     window's total wall stress in 10-strain bins (model3_mn01_windows.png)."""
@@ -126,9 +184,9 @@ def model3_mn01(folders, paper):
         lines.append(f"- {6 - len(ss)} of the design's seeds still running or queued.")
     lines += ["", "![total wall stress per run](model3_mn01_windows.png)", ""]
     if missing:
-        lines.append(f"Not in the figure: seed(s) {', '.join(missing)}, whose runs predate the archived windows "
-                     "(window_series.csv).")
-    return lines + [""]
+        lines += [f"Not in the figure: seed(s) {', '.join(missing)}, whose runs predate the archived windows "
+                  "(window_series.csv).", ""]
+    return lines + model3_long(paper, from_runs, [s for _, s in ss], [s for _, s in summaries(folders, 0.1)])
 
 
 def runs(folders):
@@ -206,7 +264,7 @@ def main():
         lines.append(f"| {mn:g} | {len(ss)} | {sum(tot) / len(tot):.4g} | {sd3} | {sdall} | {err:.2g} | "
                      f"{', '.join(bad) if bad else 'none'} |")
     lines.append("")
-    lines += model3_mn01(folders, paper)
+    lines += model3_mn01(folders, paper, "--runs" in sys.argv)
     ax.set_xlabel("strain")
     ax.set_ylabel("particle wall stress (Pa), 10-strain bins")
     ax.set_title("Model 1, Mn 0.1, paper cell: the averaging window of each seed")

@@ -15,14 +15,16 @@ so is the convergence table (reports/study/paper/convergence.md) from
 reports/study/paper/convergence/points. Model 1 takes the extra seeds of
 experiments/sweeps/paper_mn01_states.toml (Mn 0.1) and
 paper_model1_seeds.toml (the other Mn) into its headline points,
-and reports/paper_model1_seeds.py shows every seed's window
+and reports/paper_model1_seeds.py shows every seed's window (and, beside
+model 3's point at Mn 0.1, never in it, the long runs of
+paper_mn01_long.toml by the reading fixed there)
 (reports/study/paper/model1_seeds.md); model 3 at Mn 0.1 takes those of
 paper_mn01_coupled_seeds.toml. reports/paper_tolerance.py applies
 the rules of experiments/sweeps/paper_tolerance.toml,
 paper_tolerance_coupled.toml and experiments/branch_tolerance.txt to their
 runs (reports/study/paper/tolerance.md).
 
-With --runs the nine sweeps are read from their run folders
+With --runs the ten sweeps are read from their run folders
 (out/sweeps/<sweep name>, laid out as an archive is) instead of the
 committed archives: what `scripts/reproduce paper` does after running them
 from scratch.
