@@ -151,13 +151,7 @@ def model3_mn01(folders, paper, from_runs=False):
         strain = [float(r["strain"]) for r in rows]
         edges, fine = bins(strain, [float(r["stress_total_Pa"]) for r in rows], s["warmup_strain"], s["strain"], 10.0)
         ax.plot([0.5 * (a + b) for a, b in zip(edges[:-1], edges[1:])], fine, "o-", ms=3, label=f"seed {seed}")
-    ax.set_xlabel("strain")
-    ax.set_ylabel("total wall stress (Pa), 10-strain bins")
-    ax.set_title("Model 3, Mn 0.1, paper cell: the averaging window of each seed")
-    ax.legend(fontsize=7, ncol=2)
-    fig.tight_layout()
-    fig.savefig(os.path.join(paper, "model3_mn01_windows.png"), dpi=90)
-    plt.close(fig)
+    save_windows(fig, ax, "total wall stress (Pa), 10-strain bins", "Model 3", os.path.join(paper, "model3_mn01_windows.png"))
     lines = ["## Model 3 at Mn 0.1: three seeds against six", "",
              "Seeds 1-3 from the headline sweep (their last runs), seeds 4-6 from "
              "`experiments/sweeps/paper_mn01_coupled_seeds.toml` (200 strain units, 100 of warm-up; fixed in "
@@ -197,6 +191,17 @@ def runs(folders):
         rows = window_rows(d, s["warmup_strain"])
         out.append((seed, s, [float(r["strain"]) for r in rows], [float(r["stress_particles_Pa"]) for r in rows]))
     return out
+
+
+def save_windows(fig, ax, ylabel, model, path):
+    """Labels, legend and file of a figure of each seed's averaging window at Mn 0.1."""
+    ax.set_xlabel("strain")
+    ax.set_ylabel(ylabel)
+    ax.set_title(f"{model}, Mn 0.1, paper cell: the averaging window of each seed")
+    ax.legend(fontsize=7, ncol=2)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
 
 
 def bins(strain, values, lo, hi, width):
@@ -265,12 +270,7 @@ def main():
                      f"{', '.join(bad) if bad else 'none'} |")
     lines.append("")
     lines += model3_mn01(folders, paper, "--runs" in sys.argv)
-    ax.set_xlabel("strain")
-    ax.set_ylabel("particle wall stress (Pa), 10-strain bins")
-    ax.set_title("Model 1, Mn 0.1, paper cell: the averaging window of each seed")
-    ax.legend(fontsize=7, ncol=2)
-    fig.tight_layout()
-    fig.savefig(os.path.join(paper, "model1_mn01_windows.png"), dpi=90)
+    save_windows(fig, ax, "particle wall stress (Pa), 10-strain bins", "Model 1", os.path.join(paper, "model1_mn01_windows.png"))
     with open(os.path.join(paper, "model1_seeds.md"), "w") as fh:
         fh.write("\n".join(lines))
     print(f"paper_model1_seeds: {n} runs at Mn 0.1 -> {paper}/model1_seeds.md")
