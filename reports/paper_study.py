@@ -14,6 +14,7 @@ usage: paper_study.py SWEEP_DIR OUT_DIR [--small reports/study/flow_curves.csv]
                       [--first-runs reports/study/paper/first_runs]
                       [--second-runs reports/study/paper/second_runs]
                       [--short-window-runs reports/study/paper/short_window_runs] [--note TEXT]
+                      [--points reports/study/paper/points]
                       [--small-criterion reports/study/criterion_default.json]
                       [--reanalysed reports/study/paper/reanalysed.json]
                       [--convergence reports/study/paper/convergence.md]
@@ -38,6 +39,8 @@ listed under the steadiness table with what their re-runs gave;
 --short-window-runs: the coupled runs at Mn 1e-3 that session 34's
 one-window rule runs again over strain 16-48 (each point's seed mean before
 the rule against now is tabulated).
+--points: the realistic sweep's point folders (archive layout), whose
+window_series.csv give the one-window runs' totals in 8-strain bins.
 --note: a paragraph under the title (what state the report is in).
 --reanalysed: `mrf reanalyse` records of archived runs (scripts/paper_interim.py
 writes them from the archive's window_series.csv files), for a post-hoc
@@ -480,7 +483,7 @@ def low_mn(argv, here, crit, phi, aqs_quote):
     return lines
 
 
-def one_window(rows, firsts, phi):
+def one_window(rows, firsts, phi, points):
     """Session 34's one-window rule for the coupled models at Mn 1e-3, as it
     asked to be reported: each point's seed mean before it (each seed's
     short-window run if it has one, else its second run, else its entry: the
@@ -509,7 +512,38 @@ def one_window(rows, firsts, phi):
                      "The rule's runs replace the 4-12 ones as they finish.", "",
                      "| model | runs | windows (strain) | total wall stress | fluid part |", "|---|---|---|---:|---:|"]
         lines += [line("session 33's", before), line("now", now)]
-    return lines
+    return lines + window_bins(rows, points)
+
+
+def window_bins(rows, points):
+    """How far the one-window runs (16-48) still move inside their window: the
+    total in 8-strain bins from each run's window_series.csv, and the second
+    half's mean against the window's, in the run's own standard error. A
+    description, not a test: the rule's verdict is the drift test's."""
+    out = []
+    for r in rows:
+        if abs(float(r["mason"]) - 1e-3) > 1e-9 or (num(r, "warmup_strain"), num(r, "strain")) != (16.0, 48.0):
+            continue
+        path = os.path.join(points, r["model"], f"mn_{float(r['mason']):g}_seed_{int(r['seed'])}", "window_series.csv")
+        if not os.path.exists(path):
+            continue
+        series = [(num(x, "strain"), num(x, "stress_total_Pa")) for x in read_rows(path)]
+        def mean(lo, hi):
+            v = [t for g, t in series if lo < g <= hi]
+            return statistics.mean(v) if v else float("nan")
+        whole, err = num(r, "stress_total"), num(r, "stress_total_err")
+        late = mean(32, 48)
+        out.append(f"| {r['model']} | {r['seed']} | {whole:.0f} ± {err:.0f} | "
+                   + " | ".join(f"{mean(lo, lo + 8):.0f}" for lo in (16, 24, 32, 40))
+                   + f" | {late:.0f} | {(late - whole) / err:+.1f} |")
+    if not out:
+        return []
+    return ["", "Inside the one window (strain 16-48), each run's total wall stress in 8-strain bins (Pa, plain means "
+            "of its window_series.csv) and the mean over the second half (32-48) against the window's, in the run's "
+            "own standard error: how far the value still moves with the window's start. A description, not a "
+            "test (the rule's verdict is the drift test above).", "",
+            "| model | seed | 16-48 (the rule's) | 16-24 | 24-32 | 32-40 | 40-48 | 32-48 | (32-48) - (16-48), in its error |",
+            "|---|---:|---:|---:|---:|---:|---:|---:|---:|"] + out
 
 
 def sweep_cost(rows, firsts):
@@ -716,7 +750,7 @@ def main(argv):
                          f"{f['strain']:g} ({f['warmup_strain']:g}) | "
                          f"{f['stress_total_drift_z']:+.2f} | {f['steady_mser_discard_fraction']:.3f} | "
                          f"{'yes' if ok else '**no**'} | {state} |")
-    lines += one_window(rows, firsts, phi)
+    lines += one_window(rows, firsts, phi, arg(argv, "--points", os.path.join(here, "study", "paper", "points")))
     lines += ["", "Cost: wall seconds per strain unit of each run, one thread, on a shared 2-core machine "
               "(the sweep ran at nice 19 beside other work: an upper bound, not a benchmark; "
               "reports/performance/model_ratios.md has the side-by-side ratios).", ""]

@@ -189,7 +189,8 @@ def main():
     finally:
         if os.path.exists(tmp):
             os.remove(tmp)
-    cmd = ["/usr/bin/python3", "reports/paper_study.py", "out/sweeps/paper_realistic_interim", paper]
+    cmd = ["/usr/bin/python3", "reports/paper_study.py", "out/sweeps/paper_realistic_interim", paper,
+           "--points", src["paper_realistic"]]
     if "--note" in sys.argv:
         cmd += ["--note", arg("--note", "")]
     subprocess.run(cmd, check=True)

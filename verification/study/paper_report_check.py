@@ -50,6 +50,13 @@ POST_HOC = {("dem_stokes", 0.1, 1, 30, 1, 5.0): "untested; post hoc: particle dr
             ("demsph_dd", 1e-3, 1, 30, 2, 0.0): "**particle drift z +3.5**"}  # judged by the rule itself
 
 
+# One run of the one-window rule (strain 16-48 at Mn 1e-3): its window series
+# falls linearly by ONE_WINDOW_SLOPE Pa per strain unit through the row's
+# stress at strain 32, sampled every 0.1 strain unit, so each bin's mean is the
+# line at the bin's middle.
+ONE_WINDOW, ONE_WINDOW_SLOPE = ("demsph_stokes", 1e-3, 1), -2.0
+
+
 def total(k, mn):
     c, e = MODELS[k]
     return c + e * mn / (4.5 * PHI)  # tau / (phi mu0 M^2)
@@ -71,7 +78,8 @@ def main(argv):
                 for seed in (1, 2, 3):
                     # the same stress for every seed (no scatter), 0.5 % within-run error
                     v, tind, pz, pind, _ = RULE.get((k, mn, seed), (1, "", 0.5, "", "untested"))
-                    w.writerow([k, mn, seed, "ok", GDOT, 30, 8, repr(tau), repr(0.005 * tau), 0.1, 0.0,
+                    strain, warmup = (48, 16) if (k, mn, seed) == ONE_WINDOW else (30, 8)
+                    w.writerow([k, mn, seed, "ok", GDOT, strain, warmup, repr(tau), repr(0.005 * tau), 0.1, 0.0,
                                 repr(e * ETA * GDOT), repr(tau), 4125, 100.0, 1e-4, 6e-5, repr(m), PHI, ETA, 1000.0,
                                 1.5e-4, 2.5e-6, v, tind, pz, pind])
     subprocess.run([mrf, "criterion", sweep], check=True, stdout=subprocess.DEVNULL)
@@ -107,8 +115,20 @@ def main(argv):
                             2.5e-6, 1, "", 0.5, ""])
         return path
 
+    k, mn, seed = ONE_WINDOW
+    tau1 = total(k, mn) * PHI * MU0 * 9 * ETA * GDOT / (2 * MU0 * mn)
+    run_dir = os.path.join(work, "points", k, f"mn_{mn:g}_seed_{seed}")
+    os.makedirs(run_dir)
+    with open(os.path.join(run_dir, "window_series.csv"), "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["time_s", "strain", "stress_total_Pa"])
+        for i in range(1, 321):
+            g = 16 + 0.1 * i
+            w.writerow([g / GDOT, g, repr(tau1 + ONE_WINDOW_SLOPE * (g - 32))])
+
     def report(out_dir, low):
         subprocess.run([py, os.path.join(root, "reports", "paper_study.py"), sweep, out_dir,
+                        "--points", os.path.join(work, "points"),
                         "--small", none, "--quasistatic", none, "--fixed-m", none, "--first-runs", none,
                         "--small-criterion", os.path.join(sweep, "criterion.json"), "--reanalysed", late,
                         "--low-mn", low], check=True, stdout=subprocess.DEVNULL)
@@ -208,6 +228,18 @@ def main(argv):
         line = [x for x in text.splitlines() if x.startswith("s (3e-4 to 1e-3)")]
         if not line or want not in line[0]:
             failures.append(f"low-Mn reading: {line[:1]}, want {want}")
+    # The one-window run's bins (the line at each bin's middle) and its second
+    # half against the row's stress, in the row's error (0.5 %).
+    sect = md.split("Inside the one window")[1].split("\n\n", 2)[1] if "Inside the one window" in md else ""
+    hit = [x for x in sect.splitlines() if x.startswith(f"| {ONE_WINDOW[0]} | {ONE_WINDOW[2]} | ")]
+    if len(hit) != 1:
+        failures.append(f"one-window bins: {len(hit)} rows for {ONE_WINDOW}, want 1")
+    else:
+        cells = [x.strip() for x in hit[0].strip("|").split("|")]
+        for col, mid in zip(range(3, 8), (20.05, 28.05, 36.05, 44.05, 40.05)):
+            check(f"one-window bin {cells[col]} at strain {mid}", float(cells[col]),
+                  tau1 + ONE_WINDOW_SLOPE * (mid - 32), 0.6)
+        check("one-window second half, in its error", float(cells[8]), ONE_WINDOW_SLOPE * 8.05 / (0.005 * tau1), 0.06)
     for f in failures:
         print("FAIL:", f)
     print(f"paper report check: {len(failures)} failure(s)")
