@@ -86,5 +86,28 @@ TEST(SphCouette, ProfileHelperBinsAcrossGap) {
   }
 }
 
+// The first layer at the walls: on the lattice it holds exactly the count
+// it is measured against (1); moving a third of it, then all of it, past one
+// spacing from its wall gives 2/3, then 0; Couette flow keeps the lattice's
+// layers (1 after start-up).
+TEST(SphCouette, WallLayerFractionCountsTheFirstLayer) {
+  FluidCell c = channel(15, k_gdot, 0.0);
+  EXPECT_DOUBLE_EQ(wall_layer_fraction(c), 1.0);
+  const double edge = 0.5 * c.box.gap - c.params.spacing;
+  std::vector<std::size_t> first;
+  for (std::size_t a = 0; a < c.fluid.size(); ++a)
+    if (std::abs(c.fluid.x[a].x()) > edge) first.push_back(a);
+  ASSERT_EQ(first.size(), 18u);  // 2 walls x 3 x 3
+  const auto recede = [&](std::size_t a) { c.fluid.x[a].x() -= std::copysign(0.6 * c.params.spacing, c.fluid.x[a].x()); };
+  for (std::size_t k = 0; k < first.size(); k += 3) recede(first[k]);
+  EXPECT_DOUBLE_EQ(wall_layer_fraction(c), 2.0 / 3.0);
+  for (std::size_t k = 0; k < first.size(); ++k)
+    if (k % 3 != 0) recede(first[k]);
+  EXPECT_DOUBLE_EQ(wall_layer_fraction(c), 0.0);
+  FluidCell flow = channel(15, k_gdot, 0.0);
+  run_to(flow, 0.3 * k_t_visc, explicit_dt(flow), false);
+  EXPECT_DOUBLE_EQ(wall_layer_fraction(flow), 1.0);
+}
+
 }  // namespace
 }  // namespace mrf::test

@@ -65,6 +65,13 @@ DensityStats density_stats(const FluidCell& c) {
   return s;
 }
 
+double wall_layer_fraction(const FluidCell& c) {
+  const double dx = c.params.spacing, edge = 0.5 * c.box.gap - dx;
+  const double lattice = 2.0 * std::round(c.box.ly / dx) * std::round(c.box.lz / dx);
+  const auto near = std::count_if(c.fluid.x.begin(), c.fluid.x.end(), [&](const Vec3& x) { return std::abs(x.x()) > edge; });
+  return static_cast<double>(near) / lattice;
+}
+
 double total_mass(const FluidCell& c) { return c.mass * static_cast<double>(c.fluid.size()); }
 
 Vec3 total_momentum(const FluidCell& c) {

@@ -146,6 +146,7 @@ void CoupledModel::finish(RunSummary& s) const {
   s.extra["momentum_drift_N_s"] = drift.norm();
   s.extra["momentum_drift_relative"] = scale > 0 ? drift.norm() / scale : 0.0;
   s.extra["sph_wall_reflections"] = static_cast<double>(sums_.wall_reflections);
+  s.extra["sph_wall_layer_fraction_end"] = wall_layer_fraction(fluid_);
   s.extra["coupling_pair_builds"] = static_cast<double>(coupling_cache_.builds);
   if (implicit_) {
     report_implicit(implicit_->counters(), time_, steps_, s);

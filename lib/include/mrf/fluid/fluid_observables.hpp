@@ -44,6 +44,12 @@ struct DensityStats {
 };
 DensityStats density_stats(const FluidCell& c);
 
+// The fluid's first layer at the walls: fluid particles within one lattice
+// spacing of either wall plane, over the count the starting lattice puts
+// there (2 ly lz / dx^2). 1 on the lattice; below 1 when the layer next to the
+// walls has receded into the bulk (docs/study.md, "The carrier's wall layer").
+double wall_layer_fraction(const FluidCell& c);
+
 double total_mass(const FluidCell& c);      // kg
 Vec3 total_momentum(const FluidCell& c);    // kg m/s
 
