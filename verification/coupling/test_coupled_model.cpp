@@ -241,6 +241,33 @@ TEST(CoupledModel, SmallSceneRunsAtExtremeMasonNumbers) {
     }
 }
 
+// fluid.eos_reference: "start" gives every SPH particle its intrinsic density
+// at the start as EOS reference (so the start carries no pressure), "common"
+// the fluid density (so the porosity field's pressure is there from the
+// start: larger where eps is lower than the mean the mass is scaled by).
+TEST(CoupledModel, EosReferenceIsEachParticlesStartOrTheFluidDensity) {
+  for (const char* ref : {"start", "common"}) {
+    const LoadedScene scene =
+        load_scene(kSmall, {"scene.model=\"demsph_dd\"", std::string("fluid.eos_reference=\"") + ref + "\""});
+    ShearCell cell = build_shear_cell(scene.config);
+    FluidCell fluid = build_coupled_fluid(scene.config, cell);
+    const CoupledModel m(std::move(cell), dem_params(scene.config), std::move(fluid), CoupledDrag::di_felice, 3e-8, 12);
+    const FluidParticles& f = m.fluid().fluid;
+    double p_max = 0;
+    for (std::size_t a = 0; a < f.size(); ++a) {
+      if (std::string(ref) == "start") {
+        EXPECT_DOUBLE_EQ(f.rest_density[a], f.rho[a] / f.eps[a]) << a;
+      } else {
+        EXPECT_EQ(f.rest_density[a], scene.config.fluid_density) << a;
+      }
+      p_max = std::max(p_max, std::abs(f.p[a]));
+    }
+    const double rho_c2 = scene.config.fluid_density * m.fluid().c0 * m.fluid().c0;
+    if (std::string(ref) == "start") EXPECT_LT(p_max, 1e-12 * rho_c2);
+    else EXPECT_GT(p_max, 1e-2 * rho_c2);  // intrinsic densities of the start span several per cent
+  }
+}
+
 // A non-finite particle state stops the run with a NumericalError naming the
 // particle and the step.
 TEST(CoupledModel, NonFiniteStateIsReportedWithParticleAndStep) {

@@ -129,6 +129,14 @@ TEST(Checkpoint, FingerprintDifferenceNamesTheKeysThatDiffer) {
   EXPECT_EQ(fingerprint_difference(scene_fingerprint(a), scene_fingerprint(b)),
             "numerics.newton_tol 1e-06 (default) in the checkpoint, 1e-05 now");
   b = a;
+  b.eos_reference = EosReference::common;
+  EXPECT_EQ(fingerprint_difference(scene_fingerprint(a), scene_fingerprint(b)),
+            "fluid.eos_reference start (default) in the checkpoint, common now");
+  b.newton_tol = 1e-7;
+  EXPECT_EQ(fingerprint_difference(scene_fingerprint(b), scene_fingerprint(a)),
+            "numerics.newton_tol 1e-07 in the checkpoint, 1e-06 (default) now; "
+            "fluid.eos_reference common in the checkpoint, start (default) now");
+  b = a;
   b.model = ModelId::demsph_dd;
   EXPECT_EQ(fingerprint_difference(scene_fingerprint(a), scene_fingerprint(b)),
             "scene.model dem_stokes in the checkpoint, demsph_dd now");

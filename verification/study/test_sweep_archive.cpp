@@ -37,11 +37,14 @@ TEST(SweepArchive, SceneIdChangesWithEveryParameterAndOnlyThen) {
   EXPECT_EQ(base.size(), 8u);
   EXPECT_EQ(scene_id(load_scene(path).config), base);
   for (const char* set : {"scene.seed=99", "drive.strain=7", "particles.magnetization=2e5", "fluid.viscosity=0.2",
-                          "contact.youngs_modulus=3e10", "numerics.newton_tol=1e-7"})
+                          "contact.youngs_modulus=3e10", "numerics.newton_tol=1e-7",
+                          "fluid.eos_reference=\"common\""})
     EXPECT_NE(scene_id(load_scene(path, {set}).config), base) << set;
-  // numerics.newton_tol came after points were archived: at its default it
-  // leaves the scene_id of every earlier scene as it was
+  // numerics.newton_tol and fluid.eos_reference came after points were
+  // archived: at their defaults they leave the scene_id of every earlier
+  // scene as it was
   EXPECT_EQ(scene_id(load_scene(path, {"numerics.newton_tol=1e-6"}).config), base);
+  EXPECT_EQ(scene_id(load_scene(path, {"fluid.eos_reference=\"start\""}).config), base);
 }
 
 // The committed archive of the paper study still matches the scenes its

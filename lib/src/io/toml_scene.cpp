@@ -64,6 +64,7 @@ enum class Need { required, optional, sph_models, one_of_drive };
 
 using Target = std::variant<double SceneConfig::*, int SceneConfig::*, std::uint64_t SceneConfig::*,
                             ModelId SceneConfig::*, IntegratorId SceneConfig::*, MasonBy SceneConfig::*,
+                            EosReference SceneConfig::*,
                             std::optional<double> SceneConfig::*>;
 
 struct KeySpec {
@@ -94,6 +95,7 @@ const KeySpec k_keys[] = {
     {"fluid.density", &C::fluid_density, Dim::density, Need::required, k_pos},
     {"fluid.sph_spacing", &C::sph_spacing, Dim::length, Need::sph_models, k_pos},
     {"fluid.sound_speed", &C::sound_speed, Dim::velocity, Need::optional, k_nonneg},
+    {"fluid.eos_reference", &C::eos_reference, Dim::none, Need::optional, k_any},
     {"drive.vary", &C::vary, Dim::none, Need::optional, k_any},
     {"drive.mason", &C::mason, Dim::none, Need::one_of_drive, k_pos},
     {"drive.shear_rate", &C::shear_rate, Dim::rate, Need::one_of_drive, k_pos},
@@ -113,6 +115,7 @@ const KeySpec k_keys[] = {
 
 constexpr ModelId k_models[] = {ModelId::dem_stokes, ModelId::demsph_stokes, ModelId::demsph_dd, ModelId::dem_dd};
 constexpr MasonBy k_vary[] = {MasonBy::shear_rate, MasonBy::magnetization};
+constexpr EosReference k_eos_references[] = {EosReference::start, EosReference::common};
 constexpr IntegratorId k_integrators[] = {IntegratorId::automatic, IntegratorId::verlet_exp,
                                           IntegratorId::overdamped, IntegratorId::implicit};
 
@@ -129,6 +132,7 @@ void assign(SceneConfig& c, const KeySpec& spec, const Value& val) {
                  [&](ModelId C::*m) { c.*m = read_choice(val, k_models); },
                  [&](IntegratorId C::*m) { c.*m = read_choice(val, k_integrators); },
                  [&](MasonBy C::*m) { c.*m = read_choice(val, k_vary); },
+                 [&](EosReference C::*m) { c.*m = read_choice(val, k_eos_references); },
                  [&](std::optional<double> C::*m) {  // "auto" or a number
                    const auto* s = std::get_if<std::string>(&val.v);
                    if (s && trim(*s) == "auto") c.*m = std::nullopt;

@@ -46,6 +46,7 @@ double magnetization_from_mason(double mason, double viscosity, double shear_rat
 }
 
 const char* to_string(MasonBy v) { return v == MasonBy::shear_rate ? "shear_rate" : "magnetization"; }
+const char* to_string(EosReference v) { return v == EosReference::start ? "start" : "common"; }
 
 std::optional<DriveProblem> derived_drive_problem(const SceneConfig& c, bool mason_given) {
   const auto fail = [&](const char* key, const char* what, double value) {

@@ -115,12 +115,16 @@ CoupledModel::CoupledModel(ShearCell cell, const DemParams& params, FluidCell fl
   // The rest state: each SPH particle's intrinsic density at the start is its
   // EOS reference, so the start carries no pressure from the porosity field
   // (near the walls eps is higher than the mean 1 - phi the mass is scaled
-  // by); later changes of eps displace the fluid through the pressure.
+  // by); later changes of eps displace the fluid through the pressure. Or,
+  // with a common reference, rho0 for every particle: the start's pressure
+  // then moves the fluid toward the walls, where eps is higher, and the first
+  // layer keeps there (docs/study.md, "The carrier's wall layer").
   fluid_.fluid.rest_density.clear();
   update_coupling_pairs();
   fluid_.fluid.rest_density.resize(fluid_.fluid.size());
   for (std::size_t a = 0; a < fluid_.fluid.size(); ++a)
-    fluid_.fluid.rest_density[a] = fluid_.fluid.rho[a] / fluid_.fluid.eps[a];
+    fluid_.fluid.rest_density[a] = fluid_.params.common_eos_reference ? fluid_.params.density
+                                                                       : fluid_.fluid.rho[a] / fluid_.fluid.eps[a];
   update_pressures(fluid_);
   update_dem_forces();
   momentum0_ = momentum();

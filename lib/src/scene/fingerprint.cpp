@@ -26,9 +26,16 @@ constexpr const char* k_fingerprint_keys[] = {
     "numerics.dt_safety", "numerics.implicit_tol", "scene.model", "numerics.integrator", "scene.seed",
     "numerics.threads", "numerics.implicit_order", "output.every", "output.frames"};
 constexpr std::size_t k_fingerprint_fields = std::size(k_fingerprint_keys);
-// numerics.newton_tol came later: only a value other than the default
-// enters, so that the scene_id of every earlier scene stays what it was
-constexpr const char* k_newton_tol_tag = "newton_tol ";
+// Keys that came later: only a value other than the default enters, tagged,
+// after the fields above, so that the scene_id of every earlier scene stays
+// what it was (append, never reorder).
+struct LaterKey {
+  const char* key;
+  const char* tag;
+  const char* shown_at_default;
+};
+constexpr LaterKey k_later_keys[] = {{"numerics.newton_tol", "newton_tol ", "1e-06 (default)"},
+                                     {"fluid.eos_reference", "eos_reference ", "start (default)"}};
 
 std::string hex(double v) {
   char buf[64];
@@ -51,11 +58,9 @@ std::string scene_fingerprint(const SceneConfig& c) {
     if (!out.empty()) out += ';';
     out += v;
   }
-  if (c.newton_tol != 1e-6) {  // the default when the key came; a literal, so a new default cannot alias it
-    out += ';';
-    out += k_newton_tol_tag;
-    out += hex(c.newton_tol);
-  }
+  // the defaults when the keys came, literals, so that a new default cannot alias them
+  if (c.newton_tol != 1e-6) out += std::string(";") + k_later_keys[0].tag + hex(c.newton_tol);
+  if (c.eos_reference != EosReference::start) out += std::string(";") + k_later_keys[1].tag + to_string(c.eos_reference);
   return out;
 }
 
@@ -67,21 +72,30 @@ std::vector<std::pair<std::string, std::string>> fingerprint_fields(const std::s
     const std::size_t end = std::min(fp.find(';', start), fp.size());
     std::string text = fp.substr(start, end - start);
     std::string key = k < k_fingerprint_fields ? k_fingerprint_keys[k] : "field " + std::to_string(k + 1);
-    if (text.rfind(k_newton_tol_tag, 0) == 0) key = "numerics.newton_tol", text.erase(0, std::strlen(k_newton_tol_tag));
+    for (const LaterKey& later : k_later_keys)
+      if (k >= k_fingerprint_fields && text.rfind(later.tag, 0) == 0)
+        key = later.key, text.erase(0, std::strlen(later.tag));
     out.emplace_back(key, text);
     start = end + 1;
   }
   return out;
 }
 
+const LaterKey* later_key(const std::string& key) {
+  for (const LaterKey& later : k_later_keys)
+    if (key == later.key) return &later;
+  return nullptr;
+}
+
 std::size_t base_fields(const std::vector<std::pair<std::string, std::string>>& f) {
-  return f.size() - (f.back().first == "numerics.newton_tol" ? 1 : 0);
+  return static_cast<std::size_t>(
+      std::count_if(f.begin(), f.end(), [](const auto& field) { return later_key(field.first) == nullptr; }));
 }
 
 std::string value_in(const std::vector<std::pair<std::string, std::string>>& f, const std::string& key) {
   for (const auto& [k, v] : f)
     if (k == key) return v;
-  return std::string();  // numerics.newton_tol at its default
+  return std::string();  // a later key at its default
 }
 }  // namespace
 
@@ -89,10 +103,10 @@ std::vector<std::string> fingerprint_keys_differing(const std::string& was, cons
   const auto a = fingerprint_fields(was), b = fingerprint_fields(now);
   if (base_fields(a) != k_fingerprint_fields || base_fields(b) != k_fingerprint_fields) return {"(format)"};
   std::vector<std::string> out;
-  for (std::size_t k = 0; k <= k_fingerprint_fields; ++k) {
-    const std::string key = k < k_fingerprint_fields ? k_fingerprint_keys[k] : "numerics.newton_tol";
+  std::vector<std::string> keys(std::begin(k_fingerprint_keys), std::end(k_fingerprint_keys));
+  for (const LaterKey& later : k_later_keys) keys.emplace_back(later.key);
+  for (const std::string& key : keys)
     if (value_in(a, key) != value_in(b, key)) out.push_back(key);
-  }
   return out;
 }
 
@@ -118,8 +132,10 @@ std::string fingerprint_difference(const std::string& was, const std::string& no
     const std::string va = value_in(a, key), vb = value_in(b, key);
     std::string sa = show(key, va, 10), sb = show(key, vb, 10);
     if (sa == sb) sa = show(key, va, 17), sb = show(key, vb, 17);
-    if (va.empty()) sa = "1e-06 (default)";
-    if (vb.empty()) sb = "1e-06 (default)";
+    if (const LaterKey* later = later_key(key)) {
+      if (va.empty()) sa = later->shown_at_default;
+      if (vb.empty()) sb = later->shown_at_default;
+    }
     out += (out.empty() ? "" : "; ") + key + " " + sa + " in the checkpoint, " + sb + " now";
   }
   return out.empty() ? "the fingerprints differ in no named key" : out;

@@ -44,6 +44,7 @@ FluidParams fluid_params_from_scene(const SceneConfig& cfg) {
   p.spacing = cfg.sph_spacing;
   p.sound_speed = cfg.sound_speed;
   p.shear_rate = cfg.shear_rate;
+  p.common_eos_reference = cfg.eos_reference == EosReference::common;
   return p;
 }
 

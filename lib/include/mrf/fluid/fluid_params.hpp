@@ -16,6 +16,9 @@ struct FluidParams {
   double body_force = 0;           // f, acceleration along z (m/s^2)
   double density_tolerance = 0.01; // delta, target relative density variation (1)
   double cg_tolerance = 1e-10;     // relative residual of the implicit viscous solve (1)
+  // With a porosity field (coupled models): the EOS reference of every
+  // particle is rho0 (true), or its intrinsic density at the start (false).
+  bool common_eos_reference = false;
 
   // Throws InputError naming the scene key (fluid.viscosity, fluid.density,
   // fluid.sph_spacing, fluid.sound_speed, drive.shear_rate, box.*); the
