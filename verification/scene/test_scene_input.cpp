@@ -353,6 +353,8 @@ const Bad k_bad[] = {
     {"CutoffBelowContact", "dipole_cutoff =", "dipole_cutoff = \"4 um\"",
      "particles.dipole_cutoff", "\"4 um\"", "must be >= 2*radius"},
     {"SeedNotInteger", "seed =", "seed = 1.5", "scene.seed", "1.5", "expected an integer"},
+    {"BadEosReference", "density = 1000", "eos_reference = \"first\"\ndensity = 1000", "fluid.eos_reference",
+     "\"first\"", "expected one of: start, common"},
     {"SyntaxError", "radius =", "radius = 2.5 um", "particles.radius", "2.5 um",
      "TOML syntax error"},
 };
