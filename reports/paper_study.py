@@ -57,7 +57,6 @@ volume-side stress, the slope of the flow curve at the lowest Mn).
 SWEEP_DIR holds sweep.csv (mrf sweep ... --collect) and criterion.json
 (mrf criterion SWEEP_DIR). Writes OUT_DIR/paper.md and its figures.
 """
-import csv
 import json
 import math
 import os
@@ -72,7 +71,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from study import (CHAIN_YIELD, COLOR, GINDER_SAT, LABEL, MN_CONVENTION, MU0, ORDER,  # noqa: E402
-                   experiment_points, num, read_rows, save)
+                   experiment_points, num, read_rows, save, strain_bin)
 
 DRIFT_Z, MSER_MAX = 3.0, 0.2  # steadiness tests of every point (DESIGN.md, issue 13)
 # The particle-part rule, fixed in session 25 before any window it judges had
@@ -527,14 +526,11 @@ def window_bins(rows, points):
         path = os.path.join(points, r["model"], f"mn_{float(r['mason']):g}_seed_{int(r['seed'])}", "window_series.csv")
         if not os.path.exists(path):
             continue
-        series = [(num(x, "strain"), num(x, "stress_total_Pa")) for x in read_rows(path)]
-        def mean(lo, hi):
-            v = [t for g, t in series if lo < g <= hi]
-            return statistics.mean(v) if v else float("nan")
+        series = read_rows(path)
         whole, err = num(r, "stress_total"), num(r, "stress_total_err")
-        late = mean(32, 48)
+        late = strain_bin(series, "stress_total_Pa", 32, 48)
         out.append(f"| {r['model']} | {r['seed']} | {whole:.0f} ± {err:.0f} | "
-                   + " | ".join(f"{mean(lo, lo + 8):.0f}" for lo in (16, 24, 32, 40))
+                   + " | ".join(f"{strain_bin(series, 'stress_total_Pa', lo, lo + 8):.0f}" for lo in (16, 24, 32, 40))
                    + f" | {late:.0f} | {(late - whole) / err:+.1f} |")
     if not out:
         return []

@@ -24,7 +24,6 @@ import csv
 import json
 import math
 import os
-import statistics
 import sys
 
 import matplotlib
@@ -33,7 +32,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from study import COLOR, LABEL, MU0  # noqa: E402
+from study import COLOR, LABEL, MU0, read_rows, strain_bin  # noqa: E402
 
 # (sweep folder, model, Mn, bin width in strain units): the runs this reads
 GROUPS = [("paper_realistic", "dem_stokes", 0.1, 25), ("paper_mn01_states", "dem_stokes", 0.1, 25),
@@ -58,17 +57,16 @@ def unit_energy(summary):
 
 def bin_run(sweep, model, mn, folder, width):
     summary = json.load(open(os.path.join(folder, "summary.json")))
-    with open(os.path.join(folder, "timeseries.csv")) as fh:
-        rows = [(float(r["strain"]), r) for r in csv.DictReader(fh)]
+    rows = read_rows(os.path.join(folder, "timeseries.csv"))
     unit = unit_energy(summary)
     out = []
     top = summary["strain"]
     for k in range(int(math.ceil(top / width - 1e-9))):
         lo, hi = k * width, min((k + 1) * width, top)
-        b = [r for g, r in rows if lo < g <= hi]
-        if not b:
+        def mean(key):
+            return strain_bin(rows, key, lo, hi)
+        if math.isnan(mean("stress_total_Pa")):
             continue
-        mean = lambda key: statistics.mean(float(r[key]) for r in b)  # noqa: E731
         out.append({"sweep": sweep, "model": model, "mason": f"{mn:g}", "seed": summary["seed"], "strain_lo": f"{lo:g}",
                     "strain_hi": f"{hi:g}", "warmup_strain": f"{summary['warmup_strain']:g}",
                     "run_strain": f"{top:g}", "dipole_energy_per_sphere": f"{-mean('energy_dipole_J') / unit:.5f}",
@@ -81,7 +79,7 @@ def bin_run(sweep, model, mn, folder, width):
 def collect(runs, table):
     """Rows of every run folder found under runs; runs whose folder is gone
     keep their rows of the committed table."""
-    old = list(csv.DictReader(open(table))) if os.path.exists(table) else []
+    old = read_rows(table) if os.path.exists(table) else []
     new, seen = [], set()
     for sweep, model, mn, width in GROUPS:
         base = os.path.join(runs, sweep, model)

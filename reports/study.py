@@ -43,6 +43,14 @@ def num(row, key):
         return float("nan")
 
 
+def strain_bin(rows, key, lo, hi):
+    """Plain mean of column `key` over the time-series rows with lo < strain
+    <= hi (a row's strain is the end of the interval it averages); nan for an
+    empty bin."""
+    v = [float(r[key]) for r in rows if lo < float(r["strain"]) <= hi]
+    return sum(v) / len(v) if v else float("nan")
+
+
 def save(fig, out, name):
     for ext in ("png", "svg"):
         fig.savefig(os.path.join(out, f"{name}.{ext}"), dpi=110, bbox_inches="tight")
