@@ -37,14 +37,21 @@ TEST(SweepArchive, SceneIdChangesWithEveryParameterAndOnlyThen) {
   EXPECT_EQ(base.size(), 8u);
   EXPECT_EQ(scene_id(load_scene(path).config), base);
   for (const char* set : {"scene.seed=99", "drive.strain=7", "particles.magnetization=2e5", "fluid.viscosity=0.2",
-                          "contact.youngs_modulus=3e10", "numerics.newton_tol=1e-7",
-                          "fluid.eos_reference=\"common\""})
+                          "contact.youngs_modulus=3e10", "numerics.newton_tol=1e-7"})
     EXPECT_NE(scene_id(load_scene(path, {set}).config), base) << set;
   // numerics.newton_tol and fluid.eos_reference came after points were
-  // archived: at their defaults they leave the scene_id of every earlier
-  // scene as it was
+  // archived: at the value every scene had before (newton_tol's default;
+  // eos_reference "start", the default until session 37) they leave the
+  // scene_id of every earlier scene as it was
   EXPECT_EQ(scene_id(load_scene(path, {"numerics.newton_tol=1e-6"}).config), base);
+  const std::string coupled = k_scenes + "/small_demsph_dd.toml";
+  const std::string start = scene_id(load_scene(coupled, {"fluid.eos_reference=\"start\""}).config);
+  EXPECT_NE(scene_id(load_scene(coupled).config), start);  // the default now: common
+  EXPECT_EQ(scene_id(load_scene(coupled, {"fluid.eos_reference=\"common\""}).config),
+            scene_id(load_scene(coupled).config));
+  // model 1 has no carrier: the key leaves its scene_id alone
   EXPECT_EQ(scene_id(load_scene(path, {"fluid.eos_reference=\"start\""}).config), base);
+  EXPECT_EQ(scene_id(load_scene(path, {"fluid.eos_reference=\"common\""}).config), base);
 }
 
 // The committed archive of the paper study still matches the scenes its

@@ -112,13 +112,13 @@ CoupledModel::CoupledModel(ShearCell cell, const DemParams& params, FluidCell fl
   }
   parcel_.u.assign(n, Vec3::Zero());
   parcel_.impulse.assign(n, Vec3::Zero());
-  // The rest state: each SPH particle's intrinsic density at the start is its
-  // EOS reference, so the start carries no pressure from the porosity field
-  // (near the walls eps is higher than the mean 1 - phi the mass is scaled
-  // by); later changes of eps displace the fluid through the pressure. Or,
-  // with a common reference, rho0 for every particle: the start's pressure
-  // then moves the fluid toward the walls, where eps is higher, and the first
-  // layer keeps there (docs/study.md, "The carrier's wall layer").
+  // The EOS reference: rho0 for every SPH particle (the default, REFERENCE
+  // §6), so the start's pressure moves the fluid into the porosity field
+  // (toward the walls, where eps is higher than the mean 1 - phi the mass is
+  // scaled by) and a fluid at rest has one intrinsic density; or each
+  // particle's intrinsic density at the start, so the start carries no
+  // pressure, but the particles carry the start's porosity field with them
+  // (docs/study.md, "The carrier's wall layer").
   fluid_.fluid.rest_density.clear();
   update_coupling_pairs();
   fluid_.fluid.rest_density.resize(fluid_.fluid.size());

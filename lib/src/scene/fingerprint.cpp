@@ -26,16 +26,19 @@ constexpr const char* k_fingerprint_keys[] = {
     "numerics.dt_safety", "numerics.implicit_tol", "scene.model", "numerics.integrator", "scene.seed",
     "numerics.threads", "numerics.implicit_order", "output.every", "output.frames"};
 constexpr std::size_t k_fingerprint_fields = std::size(k_fingerprint_keys);
-// Keys that came later: only a value other than the default enters, tagged,
-// after the fields above, so that the scene_id of every earlier scene stays
-// what it was (append, never reorder).
+// Keys that came later: only a value other than the one every scene had
+// before the key came enters, tagged, after the fields above, so that the
+// scene_id of every earlier scene stays what it was (append, never reorder).
+// That value is a literal here, not the default: fluid.eos_reference's
+// default became "common" after the key came, and "start" still enters
+// nothing.
 struct LaterKey {
   const char* key;
   const char* tag;
-  const char* shown_at_default;
+  const char* shown_when_absent;
 };
 constexpr LaterKey k_later_keys[] = {{"numerics.newton_tol", "newton_tol ", "1e-06 (default)"},
-                                     {"fluid.eos_reference", "eos_reference ", "start (default)"}};
+                                     {"fluid.eos_reference", "eos_reference ", "start"}};
 
 std::string hex(double v) {
   char buf[64];
@@ -60,7 +63,9 @@ std::string scene_fingerprint(const SceneConfig& c) {
   }
   // the defaults when the keys came, literals, so that a new default cannot alias them
   if (c.newton_tol != 1e-6) out += std::string(";") + k_later_keys[0].tag + hex(c.newton_tol);
-  if (c.eos_reference != EosReference::start) out += std::string(";") + k_later_keys[1].tag + to_string(c.eos_reference);
+  // the carrier's EOS only where there is a carrier
+  if (!is_one_way(c.model) && c.eos_reference != EosReference::start)
+    out += std::string(";") + k_later_keys[1].tag + to_string(c.eos_reference);
   return out;
 }
 
@@ -133,8 +138,8 @@ std::string fingerprint_difference(const std::string& was, const std::string& no
     std::string sa = show(key, va, 10), sb = show(key, vb, 10);
     if (sa == sb) sa = show(key, va, 17), sb = show(key, vb, 17);
     if (const LaterKey* later = later_key(key)) {
-      if (va.empty()) sa = later->shown_at_default;
-      if (vb.empty()) sb = later->shown_at_default;
+      if (va.empty()) sa = later->shown_when_absent;
+      if (vb.empty()) sb = later->shown_when_absent;
     }
     out += (out.empty() ? "" : "; ") + key + " " + sa + " in the checkpoint, " + sb + " now";
   }

@@ -18,7 +18,7 @@ struct FluidParams {
   double cg_tolerance = 1e-10;     // relative residual of the implicit viscous solve (1)
   // With a porosity field (coupled models): the EOS reference of every
   // particle is rho0 (true), or its intrinsic density at the start (false).
-  bool common_eos_reference = false;
+  bool common_eos_reference = true;
 
   // Throws InputError naming the scene key (fluid.viscosity, fluid.density,
   // fluid.sph_spacing, fluid.sound_speed, drive.shear_rate, box.*); the

@@ -23,9 +23,11 @@ inline bool is_one_way(ModelId m) { return m == ModelId::dem_stokes || m == Mode
 // at the given shear rate, M = sqrt(9 eta gdot / (2 mu0 Mn)).
 enum class MasonBy { shear_rate, magnetization };
 // The SPH carrier's equation-of-state reference in the coupled models
-// (fluid.eos_reference): each SPH particle's intrinsic density rho/eps at the
-// start, so the start carries no pressure from the porosity field, or the
-// fluid density for every particle (docs/study.md, "The carrier's wall layer").
+// (fluid.eos_reference): the fluid density for every particle (REFERENCE §6's
+// model, the default since session 37), or each SPH particle's intrinsic
+// density rho/eps at the start, so that the start carries no pressure from
+// the porosity field (the default before; the paper study pins it:
+// docs/study.md, "The carrier's wall layer").
 enum class EosReference { start, common };
 
 const char* to_string(ModelId m);
@@ -54,7 +56,7 @@ struct SceneConfig {
   double fluid_density = 0;    // kg/m^3
   double sph_spacing = 0;      // m, SPH particle spacing (SPH models only)
   double sound_speed = 0;      // m/s (SPH models only; 0 = choose from 1 % density variation)
-  EosReference eos_reference = EosReference::start;  // coupled models only
+  EosReference eos_reference = EosReference::common;  // coupled models only
   // [drive]: exactly one of mason, shear_rate is given in the file; both are
   // filled in after validation (Mn = 9 eta gdot / (2 mu0 M^2), DESIGN.md).
   // Mn = +inf for drive.shear_rate with magnetization = 0 (no magnetic
