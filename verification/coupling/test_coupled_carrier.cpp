@@ -20,6 +20,7 @@
 #include "mrf/scene/build_model.hpp"
 #include "mrf/scene/coupled_model.hpp"
 #include "mrf/scene/dem_params.hpp"
+#include "support/coupling_cell.hpp"
 
 namespace mrf {
 namespace {
@@ -37,14 +38,8 @@ Rest carrier_at_rest(bool common, int steps) {
   SceneConfig& c = scene.config;
   DemParams p = dem_params(c);
   p.mass *= 1e9;  // immobile on the time of the test
-  ShearCell cell;
-  cell.box = Box{c.gap, c.ly, c.lz};
-  const double a = c.ly / 4.0;  // 8 um lattice: phi = 0.128 in the bed
-  for (int i = 0; i < 10; ++i)
-    for (int j = 0; j < 4; ++j)
-      for (int k = 0; k < 4; ++k) cell.free.x.emplace_back(-0.5 * c.gap + (i + 0.5) * a, (j + 0.5) * a, (k + 0.5) * a);
-  cell.free.v.assign(cell.free.size(), Vec3::Zero());
-  cell.free.f.assign(cell.free.size(), Vec3::Zero());
+  // an 8 um lattice, phi = 0.128 in the bed
+  ShearCell cell = test::sphere_lattice(Box{c.gap, c.ly, c.lz}, c.ly / 4.0, 10, 4, 4);
   FluidCell fluid = build_coupled_fluid(c, cell);
   fluid.params.common_eos_reference = common;
   for (auto& v : fluid.fluid.v) v.setZero();

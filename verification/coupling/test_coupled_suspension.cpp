@@ -18,6 +18,7 @@
 #include "mrf/scene/dem_params.hpp"
 #include "mrf/scene/build_model.hpp"
 #include "mrf/scene/run.hpp"
+#include "support/coupling_cell.hpp"
 
 namespace mrf {
 namespace {
@@ -44,14 +45,8 @@ Bed fixed_bed(CoupledDrag law) {
   SceneConfig& c = scene.config;
   DemParams p = dem_params(c);
   p.mass *= 1e9;  // immobile on the time of the test
-  ShearCell cell;
-  cell.box = Box{c.gap, c.ly, c.lz};
   const double a = c.ly / 6.0;
-  for (int i = 0; i < 30; ++i)
-    for (int j = 0; j < 6; ++j)
-      for (int k = 0; k < 6; ++k) cell.free.x.emplace_back(-0.5 * c.gap + (i + 0.5) * a, (j + 0.5) * a, (k + 0.5) * a);
-  cell.free.v.assign(cell.free.size(), Vec3::Zero());
-  cell.free.f.assign(cell.free.size(), Vec3::Zero());
+  ShearCell cell = test::sphere_lattice(Box{c.gap, c.ly, c.lz}, a, 30, 6, 6);
   FluidCell fluid = build_coupled_fluid(c, cell);
   fluid.params.body_force = f;
   for (auto& v : fluid.fluid.v) v.setZero();

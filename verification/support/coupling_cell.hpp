@@ -8,6 +8,7 @@
 
 #include "mrf/coupling/exchange.hpp"
 #include "mrf/fluid/fluid_cell.hpp"
+#include "mrf/scene/shear_cell.hpp"
 
 namespace mrf::test {
 
@@ -31,6 +32,20 @@ inline std::vector<Vec3> random_points(std::size_t n, double x_lo, double x_hi, 
   std::vector<Vec3> out;
   for (std::size_t k = 0; k < n; ++k) out.emplace_back(ux(gen), uy(gen), uz(gen));
   return out;
+}
+
+// Spheres at rest on a simple cubic lattice of spacing a, nx layers from
+// the lower wall plane x = -gap/2 and ny x nz across (the fixed beds of
+// test_coupled_suspension.cpp and test_coupled_carrier.cpp).
+inline ShearCell sphere_lattice(const Box& box, double a, int nx, int ny, int nz) {
+  ShearCell cell;
+  cell.box = box;
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < ny; ++j)
+      for (int k = 0; k < nz; ++k) cell.free.x.emplace_back(-0.5 * box.gap + (i + 0.5) * a, (j + 0.5) * a, (k + 0.5) * a);
+  cell.free.v.assign(cell.free.size(), Vec3::Zero());
+  cell.free.f.assign(cell.free.size(), Vec3::Zero());
+  return cell;
 }
 
 }  // namespace mrf::test
