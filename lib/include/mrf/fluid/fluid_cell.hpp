@@ -31,7 +31,8 @@ struct FluidParticles {
   std::vector<double> eps;
   // EOS reference of each particle's intrinsic density (kg/m^3), carried
   // with the particle; empty = params.density. The coupled models set it to
-  // the intrinsic density of the start, which is then free of pressure.
+  // params.density, or with fluid.eos_reference = "start" to the intrinsic
+  // density of the start, which is then free of pressure.
   std::vector<double> rest_density;
   std::size_t size() const { return x.size(); }
 };
