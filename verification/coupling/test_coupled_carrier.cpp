@@ -2,7 +2,7 @@
 // (REFERENCE §6): the averaged continuity equation makes the fluid's
 // superficial density eps rho_f, so a carrier at rest, whatever its history,
 // has one intrinsic density rho / eps everywhere. A bed of immobile spheres
-// fills the lower half of the gap (eps about 0.8 there, 1 above); the fluid
+// fills the lower half of the gap (eps about 0.87 there, 1 above); the fluid
 // starts on its lattice, uniform in superficial density, i.e. too dense
 // inside the bed and too thin above it.
 // - fluid.eos_reference = "common" (rho_f for every particle, the model of
@@ -30,6 +30,7 @@ const std::string kSmall = MRF_SOURCE_DIR "/experiments/scenes/small_demsph_stok
 struct Rest {
   double bed, free;  // mean intrinsic density rho/eps of the SPH particles deep in the bed and above it (kg/m^3)
   double start_bed, start_free;
+  double rho_f;  // the fluid density (kg/m^3)
 };
 
 Rest carrier_at_rest(bool common, int steps) {
@@ -59,6 +60,7 @@ Rest carrier_at_rest(bool common, int steps) {
     free = sf / nf;
   };
   Rest r{};
+  r.rho_f = c.fluid_density;
   means(r.start_bed, r.start_free);
   for (int n = 0; n < steps; ++n) m.step();
   means(r.bed, r.free);
@@ -71,8 +73,8 @@ Rest carrier_at_rest(bool common, int steps) {
 // volume and the mean porosity is 1 - phi). A wrong sign of the pressure
 // force or of the EOS would drive them apart instead.
 TEST(CoupledCarrier, CommonReferenceRelaxesToOneIntrinsicDensity) {
-  const double rho_f = 1000.0;
   const Rest r = carrier_at_rest(true, 2500);
+  const double rho_f = r.rho_f;
   EXPECT_GT(r.start_bed / r.start_free - 1.0, 0.10);
   EXPECT_LT(std::abs(r.bed / r.free - 1.0), 0.003) << r.bed << " " << r.free;
   EXPECT_NEAR(r.bed, rho_f, 0.004 * rho_f);
