@@ -57,9 +57,9 @@ def combine(runs, key):
     v = [num(r, key) for r in runs]
     e = [num(r, key + "_err") for r in runs]
     n = len(v)
-    within = math.sqrt(sum(x * x for x in e)) / n if all(x == x for x in e) else float("nan")
-    scatter = statistics.stdev(v) / math.sqrt(n) if n > 1 else float("nan")
-    err = max(x for x in (within, scatter) if x == x) if (within == within or scatter == scatter) else float("nan")
+    within = math.sqrt(sum(x * x for x in e)) / n
+    scatter = statistics.stdev(v) / math.sqrt(n) if n > 1 else 0.0
+    err = max(within, scatter)
     return statistics.fmean(v), err
 
 
@@ -77,7 +77,7 @@ def plot(shifts, path):
     fig, axs = plt.subplots(1, 3, figsize=(10, 3.4))
     for ax, part in zip(axs, ["total", "fluid", "particles"]):
         for i, model in enumerate(sorted({m for m, _, _ in shifts})):
-            pts = sorted((mn, v) for m, mn, p in shifts for v in [shifts[(m, mn, p)]] if m == model and p == part)
+            pts = sorted((mn, v) for (m, mn, p), v in shifts.items() if m == model and p == part)
             if not pts:
                 continue
             x = [mn * (1.08 if i else 1 / 1.08) for mn, _ in pts]
