@@ -8,8 +8,9 @@ usage: small_eos.py [SWEEP_DIR] [OUT_DIR]
 
 Reads every finished run's summary.json under SWEEP_DIR and writes
 OUT_DIR/runs.csv (the fields used, one row a run), OUT_DIR/small_eos.md and
-OUT_DIR/small_eos.png. Without SWEEP_DIR on disk it re-reads the committed
-runs.csv, so the table regenerates from the repository alone.
+OUT_DIR/small_eos.png. The committed runs.csv is read first and a run found
+under SWEEP_DIR adds or replaces its row, so the table regenerates from the
+repository alone and grows across machines.
 
 Per model and Mn, each reference's seed mean with error
 max(sqrt(sum err^2) / n, seed standard deviation / sqrt(n)); the shift is
@@ -101,14 +102,17 @@ def main(argv):
     out_dir = argv[2] if len(argv) > 2 else os.path.join(here, "study", "small_eos")
     os.makedirs(out_dir, exist_ok=True)
     runs_csv = os.path.join(out_dir, "runs.csv")
+    # The committed runs, with any finished run under SWEEP_DIR added or
+    # replacing its row: the sweep spans machines whose run folders are lost.
+    key = lambda r: (r["model"], r["variant"], float(r["mason"]), int(r["seed"]))
+    runs = {key(r): r for r in csv.DictReader(open(runs_csv))} if os.path.exists(runs_csv) else {}
     if os.path.isdir(sweep_dir):
-        runs = from_runs(sweep_dir)
+        runs.update({key(r): r for r in from_runs(sweep_dir)})
         with open(runs_csv, "w", newline="") as fh:
             w = csv.DictWriter(fh, FIELDS)
             w.writeheader()
-            w.writerows(runs)
-    else:
-        runs = list(csv.DictReader(open(runs_csv)))
+            w.writerows(runs[k] for k in sorted(runs))
+    runs = list(runs.values())
     groups = defaultdict(list)
     for r in runs:
         groups[(r["model"], float(r["mason"]), r["variant"])].append(r)
