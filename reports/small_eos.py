@@ -116,7 +116,7 @@ def main(argv):
     groups = defaultdict(list)
     for r in runs:
         groups[(r["model"], float(r["mason"]), r["variant"])].append(r)
-    lines = ["# The SPH carrier's EOS reference on the small cell (session 37)", "",
+    lines = ["# The SPH carrier's EOS reference on the small cell (sessions 37-38)", "",
              "experiments/sweeps/small_eos_reference.toml (design and reading fixed before its runs): small cell "
              "(375 spheres, 160 SPH particles), realistic path (1e3 1/s, M varied), auto integration, one thread. "
              "`start`: each SPH particle's intrinsic density at the start is its EOS reference (the default); "
