@@ -49,6 +49,10 @@ TEST(SweepArchive, SceneIdChangesWithEveryParameterAndOnlyThen) {
   EXPECT_NE(scene_id(load_scene(coupled).config), start);  // the default now: common
   EXPECT_EQ(scene_id(load_scene(coupled, {"fluid.eos_reference=\"common\""}).config),
             scene_id(load_scene(coupled).config));
+  // nor does a two-way scene without spheres (the fluid alone: every
+  // particle has the fluid density as its reference either way)
+  EXPECT_EQ(scene_id(load_scene(coupled, {"particles.volume_fraction=0", "fluid.eos_reference=\"start\""}).config),
+            scene_id(load_scene(coupled, {"particles.volume_fraction=0"}).config));
   // model 1 has no carrier: the key leaves its scene_id alone
   EXPECT_EQ(scene_id(load_scene(path, {"fluid.eos_reference=\"start\""}).config), base);
   EXPECT_EQ(scene_id(load_scene(path, {"fluid.eos_reference=\"common\""}).config), base);
@@ -141,6 +145,63 @@ TEST(SweepArchive, FinishedPointsSurviveTheLossOfTheOutputAndStaleEntriesRunAgai
   const std::string want = scene_id(load_scene(edited.scene_path, sweep_points(edited)[1].sets).config);
   EXPECT_EQ(nlohmann::json::parse(slurp(archive / pts[1].dir / "summary.json"))["scene_id"], want);
   EXPECT_EQ(nlohmann::json::parse(slurp(archive / pts[1].dir / "summary.json"))["strain"], 0.8);
+  std::filesystem::remove_all(root);
+}
+
+// What an interruption can leave behind. A damaged record (a summary.json
+// that does not read, as a crash just after its write may leave) does not
+// count as finished: the sweep runs the point again. A point that finished
+// in the output but never reached the archive (the sweep killed between the
+// two) is archived by the next sweep. Restoring an entry over a partial run
+// removes that run's series, which would otherwise pass for the entry's.
+TEST(SweepArchive, InterruptionsLeaveNoDamagedOrMissingRecord) {
+  const auto root = std::filesystem::temp_directory_path() / "mrf_test_sweep_interrupted";
+  std::filesystem::remove_all(root);
+  const auto archive = root / "archive";
+  const std::string out = (root / "out").string();
+  SweepOptions opt;
+  opt.quiet = true;
+  opt.archive = archive.string();
+  const SweepSpec s = tiny("0.6");
+  const auto pts = sweep_points(s);
+  ASSERT_EQ(run_sweep(s, out, opt).ran, 2u);
+  const std::string good = slurp(root / "out" / pts[0].dir / "summary.json");
+
+  std::ofstream(root / "out" / pts[0].dir / "summary.json", std::ios::trunc) << "";  // the crash's empty file
+  EXPECT_FALSE(point_finished((root / "out" / pts[0].dir).string()));
+  EXPECT_TRUE(point_record_damaged((root / "out" / pts[0].dir).string()));
+  SweepOptions plain = opt;
+  plain.archive.clear();  // the archive would restore it; without one the point runs
+  EXPECT_EQ(run_sweep(s, out, plain).ran, 1u);
+  EXPECT_FALSE(point_record_damaged((root / "out" / pts[0].dir).string()));
+  EXPECT_EQ(nlohmann::json::parse(slurp(root / "out" / pts[0].dir / "summary.json"))["stress_total"],
+            nlohmann::json::parse(good)["stress_total"]);
+
+  // a finished point missing from the archive (and one whose entry is
+  // damaged) is archived from the output
+  std::filesystem::remove_all(archive / pts[1].dir);
+  std::ofstream(archive / pts[0].dir / "summary.json", std::ios::trunc) << "{";
+  const ArchiveSync late = restore_from_archive(s, pts, out, archive.string());
+  EXPECT_EQ(late.archived, 2u);
+  EXPECT_EQ(late.restored, 0u);
+  for (const auto& p : pts)
+    EXPECT_EQ(slurp(archive / p.dir / "summary.json"), slurp(root / "out" / p.dir / "summary.json")) << p.dir;
+  EXPECT_EQ(restore_from_archive(s, pts, out, archive.string()).archived, 0u);
+
+  // an entry restored over a partial run of the point: the run's checkpoint
+  // and series go, the entry's summary stays
+  std::filesystem::remove_all(root / "out" / pts[1].dir);
+  RunOptions cut;
+  cut.out_dir = (root / "out" / pts[1].dir).string();
+  cut.quiet = true;
+  cut.checkpoint_every_rows = 5;
+  cut.stop_after_steps = 40;
+  EXPECT_THROW(run_scene(load_scene(s.scene_path, pts[1].sets), cut), RunInterrupted);
+  ASSERT_TRUE(std::filesystem::exists(root / "out" / pts[1].dir / "timeseries.csv"));
+  EXPECT_EQ(restore_from_archive(s, pts, out, archive.string()).restored, 1u);
+  EXPECT_EQ(slurp(root / "out" / pts[1].dir / "summary.json"), slurp(archive / pts[1].dir / "summary.json"));
+  EXPECT_FALSE(std::filesystem::exists(root / "out" / pts[1].dir / "checkpoint.bin"));
+  EXPECT_FALSE(std::filesystem::exists(root / "out" / pts[1].dir / "timeseries.csv"));
   std::filesystem::remove_all(root);
 }
 

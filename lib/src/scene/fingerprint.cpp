@@ -63,8 +63,10 @@ std::string scene_fingerprint(const SceneConfig& c) {
   }
   // the defaults when the keys came, literals, so that a new default cannot alias them
   if (c.newton_tol != 1e-6) out += std::string(";") + k_later_keys[0].tag + hex(c.newton_tol);
-  // the carrier's EOS only where there is a carrier
-  if (!is_one_way(c.model) && c.eos_reference != EosReference::start)
+  // the carrier's EOS only where there is a carrier with spheres in it (a
+  // two-way scene without spheres builds the fluid alone, whose particles
+  // all have the fluid density as their reference either way)
+  if (!is_one_way(c.model) && c.volume_fraction > 0 && c.eos_reference != EosReference::start)
     out += std::string(";") + k_later_keys[1].tag + to_string(c.eos_reference);
   return out;
 }

@@ -73,6 +73,9 @@ void report_archive(const ArchiveSync& sync, const std::string& archive_dir, boo
   if (sync.restored > 0)
     std::fprintf(stderr, "mrf sweep: %zu finished points restored from the archive %s\n", sync.restored,
                  archive_dir.c_str());
+  if (sync.archived > 0)
+    std::fprintf(stderr, "mrf sweep: %zu points finished in the output but missing from the archive %s: archived\n",
+                 sync.archived, archive_dir.c_str());
   if (sync.series_added > 0)
     std::fprintf(stderr, "mrf sweep: %zu archive entries got their window series from the runs in the output\n",
                  sync.series_added);
@@ -268,6 +271,9 @@ SweepOutcome run_sweep(const SweepSpec& spec, const std::string& out_dir, const 
       }
       continue;
     }
+    if (point_record_damaged(dir))  // said even when quiet: a record was lost
+      std::fprintf(stderr, "mrf sweep: point %s: its summary.json or failure.json does not read (a damaged file): "
+                           "the point runs again\n", t.point->dir.c_str());
     if (!opt.quiet)
       std::fprintf(stderr, "mrf sweep: [%zu/%zu] %s Mn=%g seed %llu -> %s\n", k + 1, todo.size(),
                    t.point->model.c_str(), t.point->mason, static_cast<unsigned long long>(t.point->seed), dir.c_str());

@@ -297,9 +297,24 @@ RankInfo rank_from_environment() {
   return info;
 }
 
+namespace {
+enum class Record { absent, readable, damaged };
+Record record_state(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  if (!in) return Record::absent;
+  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  return !j.is_discarded() && j.is_object() ? Record::readable : Record::damaged;
+}
+}  // namespace
+
 bool point_finished(const std::string& point_dir) {
   const std::filesystem::path d(point_dir);
-  return std::filesystem::exists(d / "summary.json") || std::filesystem::exists(d / "failure.json");
+  return record_state(d / "summary.json") == Record::readable || record_state(d / "failure.json") == Record::readable;
+}
+
+bool point_record_damaged(const std::string& point_dir) {
+  const std::filesystem::path d(point_dir);
+  return record_state(d / "summary.json") == Record::damaged || record_state(d / "failure.json") == Record::damaged;
 }
 
 double point_strain_reached(const std::string& point_dir) {

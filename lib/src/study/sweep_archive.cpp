@@ -43,6 +43,13 @@ ArchiveSync restore_from_archive(const SweepSpec& spec, const std::vector<SweepP
   for (const SweepPoint& p : points) {
     const auto entry = std::filesystem::path(archive_dir) / p.dir / "summary.json";
     const auto dir = std::filesystem::path(out_dir) / p.dir;
+    const bool finished_here = point_finished(dir.string()) && std::filesystem::exists(dir / "summary.json") &&
+                               !point_stale(spec, p, dir);
+    if (finished_here && !archive_entry_current(spec, p, archive_dir)) {
+      archive_point(p, out_dir, archive_dir);
+      ++sync.archived;
+      continue;
+    }
     if (!std::filesystem::exists(entry)) continue;
     if (point_finished(dir.string())) {
       // an entry archived without its window series (before session 25)
@@ -63,8 +70,11 @@ ArchiveSync restore_from_archive(const SweepSpec& spec, const std::vector<SweepP
     if (claim && !claim->owned()) continue;  // not under a run of another process
     const std::string text = read_text(entry);
     std::filesystem::create_directories(dir);
-    std::filesystem::remove(dir / "checkpoint.bin");  // the point is finished: its partial run is moot
     write_file_atomic((dir / "summary.json").string(), text);
+    // the point is finished: the partial run in the folder is moot, and its
+    // series must not pass for the archived run's (archive_point takes the
+    // folder's timeseries.csv as the summary's)
+    for (const char* f : {"checkpoint.bin", "timeseries.csv", "frames.xyz"}) std::filesystem::remove(dir / f);
     ++sync.restored;
   }
   return sync;

@@ -44,6 +44,7 @@
 #pragma once
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 #include <vector>
 
 #include "mrf/box.hpp"
@@ -132,16 +133,17 @@ class ImplicitStepper {
   // start); the list-completeness test checks them.
   const std::vector<ContactPair>& candidates() const { return candidates_; }
 
-  // The history (last steps, next try, counters); the near list is derived.
+  // The history (last steps, next try, counters); the near list is derived:
+  // a load drops it, so the next step rebuilds it from the loaded positions
+  // (the models' archives call this through ArchiveWriter/Reader::io).
   template <class Archive, class Self>
   static void serialize(Archive& ar, Self& s) {
     ar.io(s.dt_, s.dt_try_, s.newton_cap_, s.counters_, s.x_prev_, s.x_prev2_, s.w_prev_, s.carrier_prev_,
           s.carrier_prev2_, s.dt_prev2_, s.history_);
-  }
-  void save(ArchiveWriter& out) const { serialize(out, *this); }
-  void load(ArchiveReader& in) {
-    serialize(in, *this);
-    near_x_.clear();  // rebuilt at the next step
+    if constexpr (!std::is_const_v<Self>) {
+      s.near_x_.clear();
+      s.near_strain_ = 0;
+    }
   }
 
  private:

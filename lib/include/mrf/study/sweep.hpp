@@ -95,8 +95,14 @@ struct RankInfo {
 RankInfo rank_from_environment();
 
 // A point is finished when its summary.json (written last, atomically) or its
-// failure.json exists; delete the folder of a failed point to run it again.
+// failure.json exists and reads as a JSON object; delete the folder of a
+// failed point to run it again. A record that does not read (a damaged file)
+// leaves the point unfinished, so a sweep runs it again (point_record_damaged
+// says so).
 bool point_finished(const std::string& point_dir);
+// The folder holds a summary.json or failure.json that does not read as a
+// JSON object.
+bool point_record_damaged(const std::string& point_dir);
 
 // How far an unfinished point's run has come: the strain of the last row of
 // its timeseries.csv, 0 when it has none or no checkpoint.bin to resume from
@@ -194,6 +200,10 @@ struct ArchiveSync {
   // entries without a window_series.csv that got one from the finished run
   // in the output whose summary.json they hold
   std::size_t series_added = 0;
+  // points finished in the output for their current scene whose entry was
+  // missing or for another scene (a sweep killed between a point's end and
+  // its archiving): archived now
+  std::size_t archived = 0;
 };
 // A folder is changed only under the point's claim (study/point_claim.hpp):
 // a point another process is running is left alone; `claimed`: the caller
