@@ -46,7 +46,7 @@ void CoupledModel::load(ArchiveReader& in) {
   check_dem_state(cell_, n_free, n_wall);
   if (f.x.size() != nf || f.v.size() != nf || f.a_ext.size() != nf || f.rest_density.size() != nf ||
       fluid_.wall.x.size() != nw || fluid_.wall.v.size() != nw)
-    throw NumericalError("checkpoint does not match the scene: SPH particle counts differ");
+    throw CheckpointError("checkpoint does not match the scene: SPH particle counts differ");
   fluid_.time = time_;
   fluid_.steps = steps_;
   // as at the end of step(); the SPH pair cache finds its candidates again

@@ -10,7 +10,7 @@ namespace mrf {
 void check_dem_state(const ShearCell& cell, std::size_t n_free, std::size_t n_wall) {
   const auto& f = cell.free;
   if (f.x.size() != n_free || f.v.size() != n_free || f.f.size() != n_free || cell.walls.x.size() != n_wall)
-    throw NumericalError("checkpoint does not match the scene: particle counts differ");
+    throw CheckpointError("checkpoint does not match the scene: particle counts differ");
 }
 
 void DemModel::load(ArchiveReader& in) {

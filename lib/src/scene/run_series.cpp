@@ -308,10 +308,13 @@ RunFiles::Elapsed RunFiles::elapsed(const LoopState& st) const {
 }
 
 bool branch_may_differ_in(const std::string& key) {
+  // not numerics.skin: the Verlet lists, and with them the skin in use,
+  // come from the parent's state, so a branch would run (and report) the
+  // parent's skin whatever its scene said
   static const char* const allowed[] = {"drive.strain",          "drive.warmup_strain", "scene.seed",
-                                        "numerics.dt",           "numerics.skin",       "numerics.dt_safety",
-                                        "numerics.implicit_tol", "numerics.threads",    "numerics.newton_tol",
-                                        "output.every",          "output.frames"};
+                                        "numerics.dt",           "numerics.dt_safety",  "numerics.implicit_tol",
+                                        "numerics.threads",      "numerics.newton_tol", "output.every",
+                                        "output.frames"};
   return std::find(std::begin(allowed), std::end(allowed), key) != std::end(allowed);
 }
 

@@ -16,7 +16,7 @@
 // as a uint64 count and the elements. A checkpoint is resumed on the kind of
 // machine that wrote it; the marker turns another kind into a clear refusal.
 //
-// Every refusal is an mrf::NumericalError naming the path and the reason:
+// Every refusal is an mrf::CheckpointError (a NumericalError) naming the path and the reason:
 // "not an mrf checkpoint" (magic word), "written on a machine of other byte
 // order", "format version X, this build reads Y", "truncated checkpoint"
 // (also a read past the end of the payload) or "corrupt checkpoint"
@@ -99,7 +99,7 @@ class ArchiveWriter {
 class ArchiveReader {
  public:
   // Reads `path` and verifies magic word, byte order, version, size and
-  // checksum, in that order; throws NumericalError on the first that fails
+  // checksum, in that order; throws CheckpointError on the first that fails
   // (std::runtime_error when the file cannot be read at all).
   explicit ArchiveReader(std::string path);
   template <class T>
@@ -126,7 +126,7 @@ class ArchiveReader {
   }
   // Payload bytes not yet read.
   std::size_t remaining() const { return end_ - pos_; }
-  // Throws NumericalError unless the whole payload has been read: a reader
+  // Throws CheckpointError unless the whole payload has been read: a reader
   // that takes fewer fields than the writer put is out of step with it.
   void expect_end() const;
   const std::string& path() const { return path_; }
