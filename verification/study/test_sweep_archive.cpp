@@ -31,6 +31,16 @@ SweepSpec tiny(const std::string& strain) {
                      "tiny.toml", k_scenes);
 }
 
+// A run into `dir` stopped after 40 steps, with checkpoints (a point under way).
+RunOptions cut_after_40_steps(const std::filesystem::path& dir) {
+  RunOptions cut;
+  cut.out_dir = dir.string();
+  cut.quiet = true;
+  cut.checkpoint_every_rows = 5;
+  cut.stop_after_steps = 40;
+  return cut;
+}
+
 TEST(SweepArchive, SceneIdChangesWithEveryParameterAndOnlyThen) {
   const std::string path = k_scenes + "/small_dem_stokes.toml";
   const std::string base = scene_id(load_scene(path).config);
@@ -191,12 +201,8 @@ TEST(SweepArchive, InterruptionsLeaveNoDamagedOrMissingRecord) {
   // an entry restored over a partial run of the point: the run's checkpoint
   // and series go, the entry's summary stays
   std::filesystem::remove_all(root / "out" / pts[1].dir);
-  RunOptions cut;
-  cut.out_dir = (root / "out" / pts[1].dir).string();
-  cut.quiet = true;
-  cut.checkpoint_every_rows = 5;
-  cut.stop_after_steps = 40;
-  EXPECT_THROW(run_scene(load_scene(s.scene_path, pts[1].sets), cut), RunInterrupted);
+  EXPECT_THROW(run_scene(load_scene(s.scene_path, pts[1].sets), cut_after_40_steps(root / "out" / pts[1].dir)),
+               RunInterrupted);
   ASSERT_TRUE(std::filesystem::exists(root / "out" / pts[1].dir / "timeseries.csv"));
   EXPECT_EQ(restore_from_archive(s, pts, out, archive.string()).restored, 1u);
   EXPECT_EQ(slurp(root / "out" / pts[1].dir / "summary.json"), slurp(archive / pts[1].dir / "summary.json"));
@@ -248,11 +254,7 @@ TEST(SweepArchive, AFinishedRunOfAnotherSceneInTheOutputRunsAgain) {
   std::filesystem::create_directories(root / "out" / pe[1].dir);
   std::ofstream(root / "out" / pe[1].dir / "failure.json") << "{\"scene_id\": \"" << id_s << "\"}";
   std::filesystem::remove_all(root / "out" / pe[0].dir);
-  RunOptions cut;
-  cut.out_dir = (root / "out" / pe[0].dir).string();
-  cut.quiet = true;
-  cut.checkpoint_every_rows = 5;
-  cut.stop_after_steps = 40;
+  const RunOptions cut = cut_after_40_steps(root / "out" / pe[0].dir);
   EXPECT_THROW(run_scene(load_scene(s.scene_path, pts[0].sets), cut), RunInterrupted);  // the old scene
   ASSERT_TRUE(std::filesystem::exists(root / "out" / pe[0].dir / "checkpoint.bin"));
   EXPECT_EQ(folder_scene_id(root / "out" / pe[0].dir), id_s);
