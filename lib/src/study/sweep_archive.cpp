@@ -43,15 +43,16 @@ ArchiveSync restore_from_archive(const SweepSpec& spec, const std::vector<SweepP
   for (const SweepPoint& p : points) {
     const auto entry = std::filesystem::path(archive_dir) / p.dir / "summary.json";
     const auto dir = std::filesystem::path(out_dir) / p.dir;
-    const bool finished_here = point_finished(dir.string()) && std::filesystem::exists(dir / "summary.json") &&
-                               !point_stale(spec, p, dir);
-    if (finished_here && !archive_entry_current(spec, p, archive_dir)) {
+    const bool finished = point_finished(dir.string());
+    // a finished run of the point's scene (not a failure) the archive lacks
+    if (finished && std::filesystem::exists(dir / "summary.json") && !point_stale(spec, p, dir) &&
+        !archive_entry_current(spec, p, archive_dir)) {
       archive_point(p, out_dir, archive_dir);
       ++sync.archived;
       continue;
     }
     if (!std::filesystem::exists(entry)) continue;
-    if (point_finished(dir.string())) {
+    if (finished) {
       // an entry archived without its window series (before session 25)
       // gets it from the run that wrote it, while that run's folder is here
       if (!std::filesystem::exists(entry.parent_path() / k_window_series_file) &&
