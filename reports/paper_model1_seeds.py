@@ -62,7 +62,7 @@ def model3_long(paper, from_runs, six, model1):
              "experiments/sweeps/paper_mn01_long.toml (fixed before its runs, session 35): seeds 7 and 8, 800 strain "
              "units with 400 of warm-up; their reading is in that file."]
     if not long:
-        return lines + ["", "Not run yet.", ""]
+        return lines + ["", "No run has finished yet (none is archived: reports/study/paper/mn01_long/points).", ""]
     lines += ["", "| seed | total over 400-800 (Pa) | drift z | MSER-5 | last two 200-strain halves: difference "
               "(own SE) | 50-strain bins (Pa) |", "|---|---|---|---|---|---|"]
     for seed, d, s in long:
