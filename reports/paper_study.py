@@ -665,23 +665,36 @@ def main(argv):
             axs[0].errorbar(xs, [small[k][m][0] / (phi * MU0 * small_m ** 2) for m in xs],
                             yerr=[small[k][m][1] / (phi * MU0 * small_m ** 2) for m in xs], fmt="x:", ms=4,
                             capsize=2, color=COLOR[k], alpha=0.6, label=LABEL[k] + " (small cell, fixed M)")
+    low_path = arg(argv, "--low-mn", os.path.join(here, "study", "paper", "low_mn_sweep.csv"))
+    low_rows = ([r for r in read_rows(low_path) if r["status"] == "ok" and r["model"] == "dem_stokes"]
+                if os.path.exists(low_path) else [])
+    if low_rows:  # model 1 below Mn 1e-3 (its section): seed mean, error max(within, scatter / sqrt(n))
+        n = len(low_rows)
+        sc = [phi * MU0 * num(r, "magnetization") ** 2 for r in low_rows]
+        errs = [num(r, "stress_total_err") / c for r, c in zip(low_rows, sc)]
+        for ax, part in ((axs[0], lambda r: num(r, "stress_total")),
+                         (axs[1], lambda r: num(r, "stress_total") - num(r, "stress_fluid"))):
+            vals = [part(r) / c for r, c in zip(low_rows, sc)]
+            err = max(math.sqrt(sum(e * e for e in errs)) / n, statistics.stdev(vals) / math.sqrt(n) if n > 1 else 0)
+            ax.errorbar([num(low_rows[0], "mason")], [sum(vals) / n], yerr=[err], fmt="D", mfc="none", ms=5,
+                        capsize=3, color=COLOR["dem_stokes"], label=f"{LABEL['dem_stokes']} below Mn 1e-3 ({n} seeds)")
     for ax in axs:
         if qs:  # the quoted AQS value (mean of the seeds) at the left edge, every run as its spread
             v, e, n_seeds = aqs_quote
-            ax.errorbar([8e-4], [v], yerr=[e], fmt="*", ms=10, color="k", capsize=3,
+            ax.errorbar([1.6e-4], [v], yerr=[e], fmt="*", ms=10, color="k", capsize=3,
                         label=f"quasi-static (AQS, Mn -> 0): mean of {n_seeds} seeds")
             others = [num(r, "stress_over_phi_mu0_m2") for r in qs]
             if others:
-                ax.plot([8e-4] * len(others), others, "k.", ms=4, alpha=0.5, label="AQS variants (increment, tol, "
+                ax.plot([1.6e-4] * len(others), others, "k.", ms=4, alpha=0.5, label="AQS variants (increment, tol, "
                         "cut-off, seed, Y)")
         ax.axhline(CHAIN_YIELD, color="k", ls="--", lw=1, label="chain model yield 0.137")
         ax.axhline(GINDER_SAT, color="gray", ls=":", lw=1, label="Ginder saturation 0.086 (Ms = M)")
         sources = sorted({e[0] for e in expt})
         for src in sources:
             vals = [v for s_, _, v in expt if s_ == src]
-            ax.plot([6e-4] * len(vals), vals, marker="s^vD<>"[sources.index(src) % 6], color="tab:red", ms=5,
+            ax.plot([1.2e-4] * len(vals), vals, marker="s^vD<>"[sources.index(src) % 6], color="tab:red", ms=5,
                     ls="none", label=f"experiment {src} (yield stress)")
-        ax.set(xscale="log", yscale="log", xlabel=f"Mason number ({MN_CONVENTION})", xlim=(5e-4, 20))
+        ax.set(xscale="log", yscale="log", xlabel=f"Mason number ({MN_CONVENTION})", xlim=(1e-4, 20))
     axs[0].set(ylabel="wall shear stress / (phi mu0 M^2)", title="total (particles + carrier)")
     axs[1].set(ylabel="(stress - fluid part) / (phi mu0 M^2)", title="particle part: tau - tau_fluid")
     axs[0].legend(fontsize=6)
