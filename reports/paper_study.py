@@ -213,6 +213,23 @@ def two_paths(argv, here, crit, phi, models):
     return lines
 
 
+def lowest_slopes(points, scale):
+    """s = d ln(tau / scale) / d ln Mn between the two lowest Mn of seed-
+    combined points (sorted by Mn), with its error, for the total and for
+    the particle part (total - fluid part); None where a value is not
+    positive."""
+    a, b = points[0], points[1]
+    out = []
+    for part in (lambda q: q["stress"], lambda q: q["stress"] - q["stress_fluid"]):
+        va, vb = part(a) / scale(a), part(b) / scale(b)
+        if va <= 0 or vb <= 0:
+            out.append(None)
+            continue
+        lr = math.log(b["mason"] / a["mason"])
+        out.append((math.log(vb / va) / lr, math.hypot(a["err"] / scale(a) / va, b["err"] / scale(b) / vb) / lr))
+    return out
+
+
 def coupled_open_at(conv, rows):
     """The Mn at which the coupled models' values are not yet results: at
     Mn 1e-3, until every coupled run there is averaged over strain 16-48
@@ -296,15 +313,12 @@ def old_claims(crit, small_crit, phi, small_m, pstate=None, open_mn=()):
             note, failing = particle_note(both), both[0]
         out = [f"{a['mason']:g}-{b['mason']:g}"]
         flat = "–"
-        for part in (lambda q: q["stress"], lambda q: q["stress"] - q["stress_fluid"]):
-            va, vb = part(a) / scale(a), part(b) / scale(b)
-            ea, eb = a["err"] / scale(a), b["err"] / scale(b)
-            lr = math.log(b["mason"] / a["mason"])
-            if va <= 0 or vb <= 0:
+        for slope in lowest_slopes(p, scale):
+            if slope is None:
                 out.append("–")
                 flat = "–"
                 continue
-            sl, se = math.log(vb / va) / lr, math.hypot(ea / va, eb / vb) / lr
+            sl, se = slope
             out.append(f"{sl:+.2f} ± {se:.2f}")
             flat = "yes" if abs(sl) <= 2 * se else "no"  # the last part: the particle part
         out[-1] += note
@@ -943,15 +957,30 @@ def main(argv):
                      f"{b['chi2_dof']:.2g} | {pw['mason_star']:.3g} ± {pw['mason_star_err']:.2g} | "
                      f"{pw['exponent']:.2f} ± {pw['exponent_err']:.2f} | {pw['chi2_dof']:.2g} | {note} |")
     lines.append("")
+    # Delta at low Mn: eta/eta_inf - 1 ~ Mn^-Delta there, and the particle
+    # part is tau - eta_inf gdot, so Delta = 1 - s of the particle part
+    # between the two lowest Mn (the claims section's slope)
+    conv_points = arg(argv, "--convergence-points", os.path.join(here, "study", "paper", "convergence", "points"))
+    open_mn, pstates, low_d = coupled_open_at(conv_points, rows), particle_state(rows), []
+    for k in models:
+        p = sorted(crit["models"][k]["points"], key=lambda q: q["mason"])
+        sl = lowest_slopes(p, lambda q: phi * MU0 * q["magnetization"] ** 2)[1] if len(p) >= 2 else None
+        if sl is None:
+            continue
+        both = [x + y for x, y in zip(*(pstates.get((k, mkey(q["mason"])), [0, 0, 0]) for q in p[:2]))]
+        status = ("not a measurement: runs fail the particle-part rule" if both[0] else
+                  "not yet a result: the coupled values at this Mn" if k != "dem_stokes" and mkey(p[0]["mason"]) in open_mn
+                  else "")
+        low_d.append(f"{k} {1 - sl[0]:.2f} ± {sl[1]:.2f}" + (f" ({status})" if status else ""))
+    if low_d:
+        lines += [f"Delta at low Mn, from the particle part between the two lowest Mn (Delta = 1 - s, s its slope in "
+                  f"the claims section; the fit above spans all five Mn): " + "; ".join(low_d) + ".", ""]
     lines += theory_and_experiment(crit, phi, expt, aqs_quote)
     low = low_mn(argv, here, crit, phi, aqs_quote, rows)
     lines += low
     small_crit_path = arg(argv, "--small-criterion", os.path.join(here, "study", "criterion_default.json"))
     small_crit = json.load(open(small_crit_path)) if os.path.exists(small_crit_path) else None
-    claims = old_claims(crit, small_crit, phi, small_m, particle_state(rows),
-                        coupled_open_at(arg(argv, "--convergence-points", os.path.join(here, "study", "paper",
-                                                                                        "convergence", "points")),
-                                        rows))
+    claims = old_claims(crit, small_crit, phi, small_m, pstates, open_mn)
     lines += claims
     lines += two_paths(argv, here, crit, phi, models)
     unsteady = defaultdict(int)

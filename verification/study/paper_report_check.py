@@ -171,6 +171,11 @@ def main(argv):
         want = "not a measurement (flat as read)" if fail_low else "yes"
         if cells[6] != want:
             failures.append(f"{k}: a flat particle part called '{cells[6]}', want '{want}'")
+        # Delta at low Mn = 1 - s of that particle part: 1 in this design
+        low_delta = next((x for x in md.splitlines() if x.startswith("Delta at low Mn")), "")
+        hit = re.search(re.escape(k) + r" ([-+0-9.]+) ± [0-9.]+( \(not a measurement)?", low_delta)
+        if not hit or abs(float(hit.group(1)) - 1.0) > 0.01 or bool(hit.group(2)) != fail_low:
+            failures.append(f"{k}: Delta at low Mn should read 1.00 (flagged: {fail_low}) in '{low_delta}'")
     # The verdict on "model 1 is 27-68 % below model 3": D_1 at each Mn from
     # the closed form, against the report's yes/no.
     claims = [line for line in md.splitlines() if line.startswith("| model 1 is 27-68 %")]
