@@ -230,6 +230,18 @@ def lowest_slopes(points, scale):
     return out
 
 
+def slope_status(k, lowest_mn, counts, open_mn):
+    """Whether a slope from the two lowest Mn is a result: '' if so, else
+    why not. counts: the two points' [fail, untested, runs] of the
+    particle-part rule (a slope from failing runs is no measurement);
+    open_mn: the Mn where the coupled values are not yet results."""
+    if counts[0]:
+        return "not a measurement"
+    if k != "dem_stokes" and mkey(lowest_mn) in open_mn:
+        return "not yet a result"
+    return ""
+
+
 def coupled_open_at(conv, rows):
     """The Mn at which the coupled models' values are not yet results: at
     Mn 1e-3, until every coupled run there is averaged over strain 16-48
@@ -306,11 +318,11 @@ def old_claims(crit, small_crit, phi, small_m, pstate=None, open_mn=()):
         if len(p) < 2:
             return None
         a, b = p[0], p[1]
-        note, failing = "", 0
+        note, counts = "", [0, 0, 0]
         if states is not None:
             sa, sb = states.get((k, mkey(a["mason"]))), states.get((k, mkey(b["mason"])))
-            both = [x + y for x, y in zip(sa or [0, 0, 0], sb or [0, 0, 0])]
-            note, failing = particle_note(both), both[0]
+            counts = [x + y for x, y in zip(sa or [0, 0, 0], sb or [0, 0, 0])]
+            note = particle_note(counts)
         out = [f"{a['mason']:g}-{b['mason']:g}"]
         flat = "–"
         for slope in lowest_slopes(p, scale):
@@ -322,10 +334,9 @@ def old_claims(crit, small_crit, phi, small_m, pstate=None, open_mn=()):
             out.append(f"{sl:+.2f} ± {se:.2f}")
             flat = "yes" if abs(sl) <= 2 * se else "no"  # the last part: the particle part
         out[-1] += note
-        if failing and flat != "–":  # the rule above: a slope from failing runs is no measurement
-            flat = f"not a measurement ({'flat' if flat == 'yes' else 'not flat'} as read)"
-        elif states is not None and k != "dem_stokes" and mkey(a["mason"]) in open_mn and flat != "–":
-            flat = f"not yet a result ({'flat' if flat == 'yes' else 'not flat'} as read)"
+        status = slope_status(k, a["mason"], counts, open_mn) if states is not None else ""
+        if status and flat != "–":
+            flat = f"{status} ({'flat' if flat == 'yes' else 'not flat'} as read)"
         pw = c["models"][k].get("power_law", {})
         out.append(f"{pw.get('exponent', float('nan')):.2f} ± {pw.get('exponent_err', float('nan')):.2f}")
         return out + [flat]
@@ -967,14 +978,13 @@ def main(argv):
         sl = lowest_slopes(p, lambda q: phi * MU0 * q["magnetization"] ** 2)[1] if len(p) >= 2 else None
         if sl is None:
             continue
-        both = [x + y for x, y in zip(*(pstates.get((k, mkey(q["mason"])), [0, 0, 0]) for q in p[:2]))]
-        status = ("not a measurement: runs fail the particle-part rule" if both[0] else
-                  "not yet a result: the coupled values at this Mn" if k != "dem_stokes" and mkey(p[0]["mason"]) in open_mn
-                  else "")
+        counts = [x + y for x, y in zip(*(pstates.get((k, mkey(q["mason"])), [0, 0, 0]) for q in p[:2]))]
+        status = slope_status(k, p[0]["mason"], counts, open_mn)
         low_d.append(f"{k} {1 - sl[0]:.2f} ± {sl[1]:.2f}" + (f" ({status})" if status else ""))
     if low_d:
         lines += [f"Delta at low Mn, from the particle part between the two lowest Mn (Delta = 1 - s, s its slope in "
-                  f"the claims section; the fit above spans all five Mn): " + "; ".join(low_d) + ".", ""]
+                  f"the claims section, with its status there; the fit above spans all five Mn): "
+                  + "; ".join(low_d) + ".", ""]
     lines += theory_and_experiment(crit, phi, expt, aqs_quote)
     low = low_mn(argv, here, crit, phi, aqs_quote, rows)
     lines += low
