@@ -2,7 +2,6 @@
 // resumed ends bit for bit as the uninterrupted run, for the DEM run and the
 // coupled DEM-SPH runs; a checkpoint never resumes into a different scene.
 #include <gtest/gtest.h>
-#include <omp.h>
 
 #include <cmath>
 #include <filesystem>
@@ -112,40 +111,6 @@ TEST(Checkpoint, RefusesACheckpointOfAnotherScene) {
     EXPECT_NE(std::string(e.what()).find("drive.shear_rate"), std::string::npos) << e.what();
     EXPECT_EQ(std::string(e.what()).find("drive.strain"), std::string::npos) << e.what();
   }
-}
-
-// numerics.threads = 0 takes the environment's count; a checkpoint written
-// on one thread does not resume on two (the sums would run in another order).
-TEST(Checkpoint, RefusesAResumeOnAnotherThreadCountWhenThreadsIsAutomatic) {
-  const auto base = std::filesystem::temp_directory_path() / "mrf_ckpt_threads";
-  std::filesystem::remove_all(base);
-  const int threads_before = omp_get_max_threads();
-  const auto auto_threads = [] {
-    return load_scene(k_scene, {"drive.mason=1", "drive.strain=0.5", "drive.warmup_strain=0.1", "numerics.integrator=\"verlet_exp\"",
-                                "output.frames=0", "numerics.threads=0"});
-  };
-  RunOptions cut;
-  cut.out_dir = base.string();
-  cut.quiet = true;
-  cut.checkpoint_every_rows = 100;
-  cut.stop_after_steps = 200;  // of 320
-  omp_set_num_threads(1);
-  EXPECT_THROW(run_scene(auto_threads(), cut), RunInterrupted);
-  ASSERT_TRUE(std::filesystem::exists(base / "checkpoint.bin"));
-  cut.stop_after_steps = 0;
-  cut.resume = true;
-  omp_set_num_threads(2);
-  try {
-    run_scene(auto_threads(), cut);
-    ADD_FAILURE() << "expected InputError";
-  } catch (const InputError& e) {
-    EXPECT_EQ(e.key(), "--resume") << e.what();
-    EXPECT_NE(std::string(e.what()).find("numerics.threads 1 in the checkpoint, 2 now"), std::string::npos)
-        << e.what();
-  }
-  omp_set_num_threads(1);  // the count it was written on resumes
-  EXPECT_NO_THROW(run_scene(auto_threads(), cut));
-  omp_set_num_threads(threads_before);
 }
 
 // The difference of two fingerprints names each key that differs, and a key

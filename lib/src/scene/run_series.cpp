@@ -229,20 +229,10 @@ long series_every(const LoadedScene& scene, long steps) {
 }
 
 
-namespace {
-// numerics.threads = 0 runs on the environment's thread count; another
-// count sums in another order, so the checkpoint holds the count it ran on
-// and a resume on another is refused (the archive's scene_id keeps the 0)
-SceneConfig with_threads_resolved(SceneConfig c) {
-  if (c.threads == 0) c.threads = omp_get_max_threads();
-  return c;
-}
-}  // namespace
-
 RunFiles::RunFiles(const RunOptions& opt, const SceneConfig& c)
     : opt_(opt),
       checkpoint_(opt.out_dir.empty() ? "" : opt.out_dir + "/checkpoint.bin"),
-      fingerprint_(scene_fingerprint(with_threads_resolved(c))) {}
+      fingerprint_(scene_fingerprint(c)) {}
 
 RunFiles::Start RunFiles::open(LoopState& st, bool with_frames, const LoadModel& load_model) {
   bool resumed = false;
