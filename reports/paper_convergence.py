@@ -10,7 +10,8 @@ usage: paper_convergence.py CONVERGENCE_SWEEP_CSV [BASE_SWEEP_CSV] [OUT_MD]
 Each variant is one seed. Its error is the larger of its within-run error
 and the base's seed scatter (the standard deviation over the base's seeds:
 a single seed of the variant scatters as a single seed of the base does);
-the base's error is max(within-run, seed scatter / sqrt(n)). The shift is
+the base's error is max(the largest within-run error of its seeds, seed
+scatter / sqrt(n)). The shift is
 quoted in per cent of the base and in combined standard errors. A variant
 whose own run is not steady (drift |z| >= 3 or MSER-5 discard >= 0.2) is
 marked: its shift is then not yet a measurement.

@@ -247,8 +247,9 @@ def coupled_open_at(conv, rows):
     Mn 1e-3, until every coupled run there is averaged over strain 16-48
     (paper_realistic.toml's one-window rule) and both coupled carrier rows
     (convergence variant eos_common_low) are in the convergence archive
-    `conv`. Without that archive (no carrier study) none."""
-    if not os.path.isdir(conv):
+    `conv`; a missing archive leaves it open. `conv` = "none" (a sweep with
+    no carrier study, as the report's check builds): nothing is open."""
+    if conv == "none":
         return set()
     rows_in = all(os.path.exists(os.path.join(conv, k, "eos_common_low", "mn_0.001_seed_1", "summary.json"))
                   for k in ("demsph_stokes", "demsph_dd"))
@@ -558,9 +559,8 @@ def low_mn(argv, here, crit, phi, aqs_quote, main_rows=()):
         lines += [f"Within the windows: {k} of the {nb} runs at Mn 1e-3 and {kl} of the {nl} at 3e-4 drift downward "
                   f"(negative drift z; two-sided sign test p = {p:.3f} and {pl:.3f})"
                   + (", every one of them within the drift test. " if all(steady(r) for r in at_base + rows) else ". ")
-                  + 
-                  "Where nearly every window still falls, the point's value is still settling, and a slope "
-                  "between two such points holds the transient as well as the Mn.", ""]
+                  + "Where nearly every window of a point still falls, that point has not settled (its settled "
+                  "value lies lower), and a slope to it holds its transient as well as the Mn.", ""]
     return lines
 
 

@@ -126,7 +126,7 @@ def main(argv):
             g = 16 + 0.1 * i
             w.writerow([g / GDOT, g, repr(tau1 + ONE_WINDOW_SLOPE * (g - 32))])
 
-    def report(out_dir, low, convergence=none):
+    def report(out_dir, low, convergence="none"):
         subprocess.run([py, os.path.join(root, "reports", "paper_study.py"), sweep, out_dir,
                         "--points", os.path.join(work, "points"),
                         "--small", none, "--quasistatic", none, "--fixed-m", none, "--first-runs", none,
