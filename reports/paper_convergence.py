@@ -38,6 +38,22 @@ def f(r, k):
         return float("nan")
 
 
+def shift(r, base):
+    """A one-seed variant row r against its base's seed rows (same model and
+    Mn), in units of the base's scale: (variant, its error, base mean, base
+    error, sigma). Variant error: max(within-run, the base's seed SD); base
+    error: max(the largest within-run error of its seeds, SD / sqrt(n))."""
+    phi = f(r, "volume_fraction")
+    sc = (phi if phi == phi else 0.30) * MU0 * f(r, "magnetization") ** 2
+    t, e = f(r, "stress_total") / sc, f(r, "stress_total_err") / sc
+    bt = [f(x, "stress_total") / sc for x in base]
+    within = max(f(x, "stress_total_err") for x in base) / sc
+    sd = statistics.stdev(bt) if len(bt) > 1 else 0.0
+    bm, be = statistics.mean(bt), max(within, sd / math.sqrt(len(bt)))
+    ve = max(e, sd)
+    return t, ve, bm, be, (t - bm) / math.hypot(be, ve)
+
+
 def plot(bars, path):
     import matplotlib
     matplotlib.use("Agg")
@@ -105,15 +121,9 @@ def main(argv):
             lines.append(f"| {r['model']} | {key[1]:g} | {r['variant']} | {t:.5f} ± {e:.5f} | – | – | – | – | "
                          f"{'yes' if steady else '**no**'} | {per:.3g} |")
             continue
-        bt = [f(x, "stress_total") / sc for x in b]
-        bp = [(f(x, "stress_total") - f(x, "stress_fluid")) / sc for x in b]
-        within = max(f(x, "stress_total_err") for x in b) / sc
-        sd = statistics.stdev(bt) if len(bt) > 1 else 0.0
-        bm, be = statistics.mean(bt), max(within, sd / math.sqrt(len(bt)))
-        ve = max(e, sd)
-        pm = statistics.mean(bp)
+        _, ve, bm, be, z = shift(r, b)
+        pm = statistics.mean([(f(x, "stress_total") - f(x, "stress_fluid")) / sc for x in b])
         vp = (f(r, "stress_total") - f(r, "stress_fluid")) / sc
-        z = (t - bm) / math.hypot(be, ve)
         bars.append((key, r["variant"], 100 * (t / bm - 1), 100 * math.hypot(ve, be * t / bm) / bm, steady))
         shifts[(r["model"], key[1], r["variant"])] = (100 * (t / bm - 1), 100 * (vp / pm - 1))
         # the lever: the largest shift in standard errors among the variants
@@ -122,7 +132,7 @@ def main(argv):
         if steady and valid and abs(z) > lever.get(key, (-1,))[0]:
             lever[key] = (abs(z), r["variant"], t / bm - 1, z, steady)
         lines.append(f"| {r['model']} | {key[1]:g} | {r['variant']} | {t:.5f} ± {ve:.5f} | {bm:.5f} ± {be:.5f} "
-                     f"({len(bt)}) | {100 * (t / bm - 1):+.1f} % | {z:+.1f} | {100 * (vp / pm - 1):+.1f} % | "
+                     f"({len(b)}) | {100 * (t / bm - 1):+.1f} % | {z:+.1f} | {100 * (vp / pm - 1):+.1f} % | "
                      f"{'yes' if steady else '**no**'} | {per:.3g} |")
     if lever:
         lines += ["", "The largest lever per model and Mn: the variant whose shift is largest in combined standard "

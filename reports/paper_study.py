@@ -70,6 +70,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from paper_convergence import shift as convergence_shift  # noqa: E402
 from study import (CHAIN_YIELD, COLOR, GINDER_SAT, LABEL, MN_CONVENTION, MU0, ORDER,  # noqa: E402
                    experiment_points, num, read_rows, save, strain_bin)
 
@@ -247,15 +248,24 @@ def coupled_open_at(conv, rows):
     Mn 1e-3, until every coupled run there is averaged over strain 16-48
     (paper_realistic.toml's one-window rule) and both coupled carrier rows
     (convergence variant eos_common_low) are in the convergence archive
-    `conv`; a missing archive leaves it open. `conv` = "none" (a sweep with
+    `conv` and neither differs from its base by more than 2 combined
+    standard errors (paper_convergence.toml, fixed in session 39: otherwise
+    the points are to be run again with the common reference); a missing
+    archive leaves it open. `conv` = "none" (a sweep with
     no carrier study, as the report's check builds): nothing is open."""
     if conv == "none":
         return set()
-    rows_in = all(os.path.exists(os.path.join(conv, k, "eos_common_low", "mn_0.001_seed_1", "summary.json"))
-                  for k in ("demsph_stokes", "demsph_dd"))
-    windows = all((num(r, "warmup_strain"), num(r, "strain")) == (16.0, 48.0) for r in rows
-                  if r["model"] != "dem_stokes" and abs(float(r["mason"]) - 1e-3) < 1e-9)
-    return set() if rows_in and windows else {mkey(1e-3)}
+    low = {k: [r for r in rows if r["model"] == k and mkey(r["mason"]) == 1e-3] for k in ("demsph_stokes", "demsph_dd")}
+    windows = all((num(r, "warmup_strain"), num(r, "strain")) == (16.0, 48.0) for v in low.values() for r in v)
+    carrier = {}
+    for k in low:
+        path = os.path.join(conv, k, "eos_common_low", "mn_0.001_seed_1", "summary.json")
+        if os.path.exists(path) and low[k]:
+            carrier[k] = convergence_shift(json.load(open(path)), low[k])[4]
+    # paper_convergence.toml (session 39): results only if neither row moves
+    # by more than 2 combined standard errors; otherwise they await a re-run
+    closed = windows and len(carrier) == 2 and all(abs(z) <= 2 for z in carrier.values())
+    return set() if closed else {mkey(1e-3)}
 
 
 def old_claims(crit, small_crit, phi, small_m, pstate=None, open_mn=()):

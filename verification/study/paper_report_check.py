@@ -62,6 +62,47 @@ def total(k, mn):
     return c + e * mn / (4.5 * PHI)  # tau / (phi mu0 M^2)
 
 
+def open_mn_failures(root, work):
+    """coupled_open_at (reports/paper_study.py), the rule of
+    paper_convergence.toml fixed in session 39: the coupled values at Mn 1e-3
+    are results only with every coupled run there over 16-48 and both carrier
+    rows in, neither beyond 2 combined standard errors of its base."""
+    sys.path.insert(0, os.path.join(root, "reports"))
+    import paper_study  # noqa: E402
+    conv = os.path.join(work, "open_mn_points")
+    m = math.sqrt(9 * ETA * GDOT / (2 * MU0 * 1e-3))
+
+    def run(k, tau, seed=1, window=(16, 48)):
+        return {"model": k, "mason": "0.001", "seed": str(seed), "warmup_strain": str(window[0]),
+                "strain": str(window[1]), "stress_total": str(tau), "stress_total_err": "1.0",
+                "magnetization": str(m), "volume_fraction": str(PHI)}
+
+    def carrier(k, tau):
+        d = os.path.join(conv, k, "eos_common_low", "mn_0.001_seed_1")
+        os.makedirs(d, exist_ok=True)
+        with open(os.path.join(d, "summary.json"), "w") as fh:
+            json.dump({"stress_total": tau, "stress_total_err": 1.0, "magnetization": m, "volume_fraction": PHI}, fh)
+
+    base = [run(k, 100.0 + sd, sd) for k in ("demsph_stokes", "demsph_dd") for sd in (1, 2, 3)]  # seed SD 1
+    out = []
+
+    def expect(what, rows, want_open):
+        got = paper_study.coupled_open_at(conv, rows)
+        if (paper_study.mkey(1e-3) in got) != want_open:
+            out.append(f"open Mn 1e-3 rule: {what}: got {got}, want {'open' if want_open else 'closed'}")
+
+    shutil.rmtree(conv, ignore_errors=True)
+    expect("no carrier rows", base, True)
+    carrier("demsph_stokes", 102.5)
+    expect("one carrier row", base, True)
+    carrier("demsph_dd", 101.0)  # sigma = (101 - 102) / hypot(1, 1) = -0.7
+    expect("both rows within 2 sigma", base, False)
+    expect("a 12-unit window left", base[:-1] + [run("demsph_dd", 103.0, 3, (4, 12))], True)
+    carrier("demsph_dd", 105.5)  # +2.47 sigma
+    expect("a row beyond 2 sigma", base, True)
+    return out
+
+
 def main(argv):
     mrf, root, work = argv[1], argv[2], argv[3]
     shutil.rmtree(work, ignore_errors=True)
@@ -262,6 +303,11 @@ def main(argv):
             check(f"one-window bin {cells[col]} at strain {mid}", float(cells[col]),
                   tau1 + ONE_WINDOW_SLOPE * (mid - 32), 0.6)
         check("one-window second half, in its error", float(cells[8]), ONE_WINDOW_SLOPE * 8.05 / (0.005 * tau1), 0.06)
+    # (in the interpreter that has matplotlib, which paper_study imports)
+    res = subprocess.run([py, os.path.abspath(__file__), "--open-mn", root, work], capture_output=True, text=True)
+    failures += [x for x in res.stdout.splitlines() if x.startswith("open Mn 1e-3 rule")]
+    if res.returncode != 0:
+        failures.append(f"open Mn 1e-3 rule: the check did not run: {res.stderr.strip()[-300:]}")
     for f in failures:
         print("FAIL:", f)
     print(f"paper report check: {len(failures)} failure(s)")
@@ -269,4 +315,7 @@ def main(argv):
 
 
 if __name__ == "__main__":
+    if sys.argv[1:2] == ["--open-mn"]:
+        print("\n".join(open_mn_failures(sys.argv[2], sys.argv[3])))
+        sys.exit(0)
     sys.exit(main(sys.argv))
