@@ -4,7 +4,9 @@
 magnetisation), the three models with seed-combined error bars, theory and
 experiment on the same axes, the small-cell study beside it, steadiness of
 every point, flow fits and cost per strain unit. Written for a sweep that is
-still running: it reports what has finished and says what has not.
+still running: it reports what has finished and says what has not. The
+rules it reads the runs by (steadiness, the particle-part rule, the claims,
+the plateau, when the coupled values at Mn 1e-3 count) are in paper_rules.py.
 
 usage: paper_study.py SWEEP_DIR OUT_DIR [--small reports/study/flow_curves.csv]
                       [--quasistatic reports/quasistatic/paper/results.csv]
@@ -70,54 +72,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from paper_convergence import shift as convergence_shift  # noqa: E402
+from paper_rules import (DRIFT_Z, MIN_INDEPENDENT, MSER_MAX, arg, coupled_open_at, fe, low_mn, lowest_slopes,  # noqa: E402
+                         mkey, old_claims, particle_note, particle_rule, particle_state, slope_status, steady)
 from study import (CHAIN_YIELD, COLOR, GINDER_SAT, LABEL, MN_CONVENTION, MU0, ORDER,  # noqa: E402
                    experiment_points, num, read_rows, save, strain_bin)
-
-DRIFT_Z, MSER_MAX = 3.0, 0.2  # steadiness tests of every point (DESIGN.md, issue 13)
-# The particle-part rule, fixed in session 25 before any window it judges had
-# been run (docs/study.md, "The particle part's rule"): a run's particle part
-# is a measurement only if its drift |z| < 3 and both it and the total are
-# worth at least MIN_INDEPENDENT independent samples (below 16 the drift test
-# of a stationary AR(1) series flags > 10x its nominal rate). It needs the
-# widened estimate (error_estimate_version 2); older runs are "untested".
-MIN_INDEPENDENT = 16
-
-
-def arg(argv, key, default):
-    return argv[argv.index(key) + 1] if key in argv else default
-
-
-def steady(r):
-    z, d = num(r, "stress_total_drift_z"), num(r, "steady_mser_discard_fraction")
-    return abs(z) < DRIFT_Z and d < MSER_MAX
-
-
-def fe(e):
-    """An error bar in phi mu0 M^2: four decimals, or two digits when smaller."""
-    return f"{e:.4f}" if e >= 1e-4 else f"{e:.1e}"
-
-
-def particle_rule(r):
-    """'ok', 'untested' (a summary without the version-2 estimate) or the
-    reasons the run's particle part fails the session-25 rule."""
-    if not num(r, "error_estimate_version") >= 2:
-        return "untested"
-    pz = num(r, "stress_particles_drift_z")
-    pind, tind = num(r, "stress_particles_independent_samples"), num(r, "stress_total_independent_samples")
-    why = []
-    if not abs(pz) < DRIFT_Z:
-        why.append(f"particle drift z {pz:+.1f}")
-    if not pind >= MIN_INDEPENDENT:
-        why.append(f"particle part {pind:.0f} samples")
-    if not tind >= MIN_INDEPENDENT:
-        why.append(f"total {tind:.0f} samples")
-    return "; ".join(why) if why else "ok"
-
-
-def mkey(mn):
-    """A Mason number as a dictionary key that sweep.csv and criterion.json agree on."""
-    return float(f"{float(mn):.6g}")
 
 
 def post_hoc(argv, here, rows):
@@ -140,27 +98,6 @@ def post_hoc(argv, here, rows):
                                   "stress_particles_independent_samples": q["stress_particles"]["independent_samples"],
                                   "stress_total_independent_samples": q["stress_total"]["independent_samples"]})
     return out
-
-
-def particle_state(rows):
-    """Per (model, Mn): how many runs' particle parts fail the rule, how many
-    are untested, how many runs."""
-    st = defaultdict(lambda: [0, 0, 0])
-    for r in rows:
-        v = particle_rule(r)
-        c = st[(r["model"], mkey(r["mason"]))]
-        c[0] += v not in ("ok", "untested")
-        c[1] += v == "untested"
-        c[2] += 1
-    return st
-
-
-def particle_note(c):
-    """The particle-part column's qualifier for a point: '' when every run
-    passes the rule."""
-    if not c or (c[0] == 0 and c[1] == 0):
-        return ""
-    return " (" + ", ".join(x for x in (f"{c[0]} fail" if c[0] else "", f"{c[1]} untested" if c[1] else "") if x) + ")"
 
 
 def two_paths(argv, here, crit, phi, models):
@@ -210,155 +147,6 @@ def two_paths(argv, here, crit, phi, models):
             bad = unsteady.get((k, f["mason"]), 0)
             seeds = f"{f['seeds']}" + (f" ({bad} unsteady)" if bad else "")
             lines.append(f"| {k} | {f['mason']:g} | {seeds} | {t:.4f} ± {fe(e)} | {st:.2g}, {re:.2g} | {cmp_} |")
-    lines.append("")
-    return lines
-
-
-def lowest_slopes(points, scale):
-    """s = d ln(tau / scale) / d ln Mn between the two lowest Mn of seed-
-    combined points (sorted by Mn), with its error, for the total and for
-    the particle part (total - fluid part); None where a value is not
-    positive."""
-    a, b = points[0], points[1]
-    out = []
-    for part in (lambda q: q["stress"], lambda q: q["stress"] - q["stress_fluid"]):
-        va, vb = part(a) / scale(a), part(b) / scale(b)
-        if va <= 0 or vb <= 0:
-            out.append(None)
-            continue
-        lr = math.log(b["mason"] / a["mason"])
-        out.append((math.log(vb / va) / lr, math.hypot(a["err"] / scale(a) / va, b["err"] / scale(b) / vb) / lr))
-    return out
-
-
-def slope_status(k, lowest_mn, counts, open_mn):
-    """Whether a slope from the two lowest Mn is a result: '' if so, else
-    why not. counts: the two points' [fail, untested, runs] of the
-    particle-part rule (a slope from failing runs is no measurement);
-    open_mn: the Mn where the coupled values are not yet results."""
-    if counts[0]:
-        return "not a measurement"
-    if k != "dem_stokes" and mkey(lowest_mn) in open_mn:
-        return "not yet a result"
-    return ""
-
-
-def coupled_open_at(conv, rows):
-    """The Mn at which the coupled models' values are not yet results: at
-    Mn 1e-3, until every coupled run there is averaged over strain 16-48
-    (paper_realistic.toml's one-window rule) and both coupled carrier rows
-    (convergence variant eos_common_low) are in the convergence archive
-    `conv` and neither differs from its base by more than 2 combined
-    standard errors (paper_convergence.toml, fixed in session 39: otherwise
-    the points are to be run again with the common reference); a missing
-    archive leaves it open. `conv` = "none" (a sweep with
-    no carrier study, as the report's check builds): nothing is open."""
-    if conv == "none":
-        return set()
-    low = {k: [r for r in rows if r["model"] == k and mkey(r["mason"]) == 1e-3] for k in ("demsph_stokes", "demsph_dd")}
-    windows = all((num(r, "warmup_strain"), num(r, "strain")) == (16.0, 48.0) for v in low.values() for r in v)
-    carrier = {}
-    for k in low:
-        path = os.path.join(conv, k, "eos_common_low", "mn_0.001_seed_1", "summary.json")
-        if os.path.exists(path) and low[k]:
-            carrier[k] = convergence_shift(json.load(open(path)), low[k])[4]
-    # paper_convergence.toml (session 39): results only if neither row moves
-    # by more than 2 combined standard errors; otherwise they await a re-run
-    closed = windows and len(carrier) == 2 and all(abs(z) <= 2 for z in carrier.values())
-    return set() if closed else {mkey(1e-3)}
-
-
-def old_claims(crit, small_crit, phi, small_m, pstate=None, open_mn=()):
-    """The small-cell study's claims (reports/study/study.md, the claims that
-    issue 13 names) against the same quantities on the paper cell. A claim
-    holds at a point when the paper-cell value lies within the claimed range
-    to two standard errors; at a Mn of open_mn (coupled values not yet
-    results) the verdict is shown as read and not counted."""
-    if not small_crit:
-        return []
-    dev = {k: {q["mason"]: q for q in v["points"]} for k, v in crit.get("deviation_from_demsph_dd", {}).items()}
-    sdev = {k: {q["mason"]: q for q in v["points"]} for k, v in small_crit.get("deviation_from_demsph_dd", {}).items()}
-    lines = ["## The small-cell study's claims, re-measured on the paper cell", "",
-             "Each claim of reports/study/study.md (375 spheres, fixed M, 2 seeds) against the same quantity "
-             "on the paper cell (realistic path, 3 seeds). D_k = tau_k / tau_3 - 1 (wall stress against model 3 "
-             "at the same Mn, mrf criterion's deviation_from_demsph_dd); 'holds' when the paper-cell value is "
-             "inside the claimed range to 2 standard errors.", "",
-             "| claim | Mn | small cell | paper cell | holds on the paper cell |", "|---|---:|---:|---:|---|"]
-
-    def row(claim, m, sq, pq, lo, hi, key="deviation", err=True):
-        sv = f"{sq[key]:+.3f}" + (f" ± {sq['err']:.3f}" if err else "") if sq else "–"
-        if not pq:
-            return f"| {claim} | {m:g} | {sv} | – | – |"
-        v, e = pq[key], (pq["err"] if err else 0.0)
-        ok = lo - 2 * e <= v <= hi + 2 * e
-        verdict = "yes" if ok else "**no**"
-        if mkey(m) in open_mn:
-            verdict = f"{'yes' if ok else 'no'} as read, not counted: the coupled values at this Mn are not yet results"
-        return f"| {claim} | {m:g} | {sv} | {v:+.3f}" + (f" ± {e:.3f}" if err else "") + f" | {verdict} |"
-
-    grid = sorted({m for v in dev.values() for m in v})
-    for m in grid:
-        lines.append(row("model 1 is 27-68 % below model 3 at every Mn (D_1 in [-0.68, -0.27])", m,
-                         sdev.get("dem_stokes", {}).get(m), dev.get("dem_stokes", {}).get(m), -0.68, -0.27))
-    for m in [m for m in grid if m <= 1.0]:
-        lines.append(row("models 2 and 3 agree within 10 % up to Mn about 1 (abs(D_2) <= 0.10)", m,
-                         sdev.get("demsph_stokes", {}).get(m), dev.get("demsph_stokes", {}).get(m), -0.10, 0.10))
-    for m in [m for m in grid if 1e-2 <= m <= 1.0]:
-        lines.append(row("model 1's volume-side stress is within 11 % of model 3 for 1e-2 <= Mn <= 1 "
-                         "(no error: seed means)", m, sdev.get("dem_stokes", {}).get(m),
-                         dev.get("dem_stokes", {}).get(m), -0.11, 0.11, key="volume_deviation", err=False))
-    # "No yield plateau down to Mn = 1e-3": the local slope of the
-    # normalised stress between the two lowest Mn (0 = a plateau, a yield
-    # stress; 1 = Newtonian), for the total and the particle part, beside
-    # the power-law exponent of the flow-curve fit.
-    lines += ["", "The yield plateau: s = d ln(tau / phi mu0 M^2) / d ln Mn between the two lowest Mn "
-              "(s = 0 is a plateau, a Mn-independent yield stress; s = 1 a Newtonian flow), of the total and of "
-              "the particle part, and the power-law fit's Delta (1 = Bingham). The small-cell claim was that "
-              "there is no plateau down to Mn = 1e-3. The last column: is the particle part flat (|s| within 2 "
-              "standard errors of 0)? The total's slope is then the carrier's viscous stress (eta gdot, in these "
-              "units proportional to Mn); the flat particle stress is not the quasi-static value (the AQS section "
-              "below).", "",
-              "In brackets after the paper cell's particle slope: how many of the two points' runs fail the "
-              "particle-part rule (steadiness section) or predate it (untested); a slope from failing runs is "
-              "not a measurement.", "",
-              "| model | cell | Mn pair | s (total) | s (particle part) | Delta (fit) | particle part flat |",
-              "|---|---|---|---:|---:|---:|---|"]
-
-    def slopes(c, k, scale, states=None):
-        p = sorted(c["models"].get(k, {}).get("points", []), key=lambda q: q["mason"])
-        if len(p) < 2:
-            return None
-        a, b = p[0], p[1]
-        note, counts = "", [0, 0, 0]
-        if states is not None:
-            sa, sb = states.get((k, mkey(a["mason"]))), states.get((k, mkey(b["mason"])))
-            counts = [x + y for x, y in zip(sa or [0, 0, 0], sb or [0, 0, 0])]
-            note = particle_note(counts)
-        out = [f"{a['mason']:g}-{b['mason']:g}"]
-        flat = "–"
-        for slope in lowest_slopes(p, scale):
-            if slope is None:
-                out.append("–")
-                flat = "–"
-                continue
-            sl, se = slope
-            out.append(f"{sl:+.2f} ± {se:.2f}")
-            flat = "yes" if abs(sl) <= 2 * se else "no"  # the last part: the particle part
-        out[-1] += note
-        status = slope_status(k, a["mason"], counts, open_mn) if states is not None else ""
-        if status and flat != "–":
-            flat = f"{status} ({'flat' if flat == 'yes' else 'not flat'} as read)"
-        pw = c["models"][k].get("power_law", {})
-        out.append(f"{pw.get('exponent', float('nan')):.2f} ± {pw.get('exponent_err', float('nan')):.2f}")
-        return out + [flat]
-
-    for k in [m for m in ORDER if m in crit["models"]]:
-        for name, c, scale, states in (("paper", crit, lambda q: phi * MU0 * q["magnetization"] ** 2, pstate),
-                                       ("small", small_crit,
-                                        lambda q: small_crit["volume_fraction"] * MU0 * small_m ** 2, None)):
-            s = slopes(c, k, scale, states)
-            if s:
-                lines.append(f"| {k} | {name} | " + " | ".join(s) + " |")
     lines.append("")
     return lines
 
@@ -499,78 +287,6 @@ def theory_and_experiment(crit, phi, expt, aqs_quote):
                   "lowest Mn (" + ", ".join(above) + "): the fit (chi2/dof far above 1, flow-curve section) "
                   "extrapolates the curvature of the higher Mn, it is no measured yield stress; the particle part at "
                   "the lowest Mn is the figure to compare.", ""]
-    return lines
-
-
-def drift_signs(runs):
-    """How many of the runs' total stress drifts inside their windows
-    (negative drift z), how many runs, and the two-sided sign-test p of
-    that count against no drift."""
-    n = len(runs)
-    k = sum(1 for r in runs if num(r, "stress_total_drift_z") < 0)
-    tail = sum(math.comb(n, i) for i in range(min(k, n - k) + 1)) / 2 ** n
-    return k, n, min(1.0, 2 * tail)
-
-
-def low_mn(argv, here, crit, phi, aqs_quote, main_rows=()):
-    """Model 1 at Mn 3e-4 (experiments/sweeps/paper_low_mn.toml), read as that
-    file fixed before its runs: the particle part's slope s from Mn 1e-3
-    (the realistic sweep's point) within 2 standard errors of 0 is a
-    plateau, above it a fall toward the quasi-static value, below a rise."""
-    path = arg(argv, "--low-mn", os.path.join(here, "study", "paper", "low_mn_sweep.csv"))
-    if not os.path.exists(path):
-        return []
-    rows = [r for r in read_rows(path) if r["status"] == "ok" and r["model"] == "dem_stokes"]
-    base = next((q for q in crit["models"].get("dem_stokes", {}).get("points", []) if mkey(q["mason"]) == 1e-3), None)
-    lines = ["## Model 1 below Mn 1e-3: is there a plateau?", "",
-             "experiments/sweeps/paper_low_mn.toml: model 1, Mn = 3e-4 on the realistic path, three seeds; its "
-             "reading was fixed in that file before the runs: the slope s of the particle part "
-             "tau_p/(phi mu0 M^2) from Mn 1e-3 within 2 standard errors of 0 is a plateau (a dynamic yield "
-             "stress), above that the stress falls toward the quasi-static value, below it rises. Errors: "
-             "max(within-run, seed scatter / sqrt(n)); each run also under the steadiness tests and the "
-             "particle-part rule.", ""]
-    if not rows or base is None:
-        return lines + [f"No run has finished yet ({len(rows)} of 3).", ""]
-    n = len(rows)
-    sc = [phi * MU0 * num(r, "magnetization") ** 2 for r in rows]
-    vals = [(num(r, "stress_total") - num(r, "stress_fluid")) / c for r, c in zip(rows, sc)]
-    errs = [num(r, "stress_total_err") / c for r, c in zip(rows, sc)]
-    mean = sum(vals) / n
-    within = math.sqrt(sum(e * e for e in errs)) / n
-    scatter = statistics.stdev(vals) / math.sqrt(n) if n > 1 else 0.0
-    err = max(within, scatter)
-    bs = phi * MU0 * base["magnetization"] ** 2
-    bv, be = (base["stress"] - base["stress_fluid"]) / bs, base["err"] / bs
-    lr = math.log(1e-3 / 3e-4)
-    slope, slope_err = math.log(bv / mean) / lr, math.hypot(err / mean, be / bv) / lr
-    verdict = ("is flat (a plateau)" if abs(slope) <= 2 * slope_err else
-               "falls toward the quasi-static value" if slope > 0 else "rises as Mn falls")
-    bad = [r["seed"] for r in rows if not steady(r)]
-    pfail = [r["seed"] for r in rows if particle_rule(r) not in ("ok", "untested")]
-    lines += ["| Mn | seeds | particle part | note |", "|---:|---:|---:|---|",
-              f"| 3e-4 | {n} | {mean:.4f} ± {fe(err)} | "
-              + (f"seed scatter / within-run {scatter / within:.2f}" if n > 1 and within > 0 else
-                 "one seed: within-run error only, which the seed scatter can exceed several times")
-              + (f"; not steady: seeds {', '.join(bad)}" if bad else "")
-              + (f"; particle-part rule not passed: seeds {', '.join(pfail)}" if pfail else "")
-              + ("; runs without the version-2 estimate (the rule untested)"
-                 if any(particle_rule(r) == "untested" for r in rows) else "") + " |",
-              f"| 1e-3 | {base['seeds']} | {bv:.4f} ± {fe(be)} | the realistic sweep |"]
-    if math.isfinite(aqs_quote[0]):
-        lines.append(f"| 0 (AQS) | {aqs_quote[2]} | {aqs_quote[0]:.4f} ± {fe(aqs_quote[1])} | quasi-static limit |")
-    lines += ["", f"s (3e-4 to 1e-3) = {slope:+.3f} ± {slope_err:.3f}: by the reading fixed in advance, the particle "
-              f"stress **{verdict}**" + (f" ({n} of 3 seeds so far: provisional)" if n < 3 else "")
-              + (" (with runs that fail a steadiness test or the particle-part rule: read with that caveat)"
-                 if bad or pfail else "") + ".", ""]
-    at_base = [r for r in main_rows if r["model"] == "dem_stokes" and mkey(r["mason"]) == 1e-3]
-    if at_base:
-        k, nb, p = drift_signs(at_base)
-        kl, nl, pl = drift_signs(rows)
-        lines += [f"Within the windows: {k} of the {nb} runs at Mn 1e-3 and {kl} of the {nl} at 3e-4 drift downward "
-                  f"(negative drift z; two-sided sign test p = {p:.3f} and {pl:.3f})"
-                  + (", every one of them within the drift test. " if all(steady(r) for r in at_base + rows) else ". ")
-                  + "Where nearly every window of a point still falls, that point has not settled (its settled "
-                  "value lies lower), and a slope to it holds its transient as well as the Mn.", ""]
     return lines
 
 
@@ -992,8 +708,8 @@ def main(argv):
         status = slope_status(k, p[0]["mason"], counts, open_mn)
         low_d.append(f"{k} {1 - sl[0]:.2f} ± {sl[1]:.2f}" + (f" ({status})" if status else ""))
     if low_d:
-        lines += [f"Delta at low Mn, from the particle part between the two lowest Mn (Delta = 1 - s, s its slope in "
-                  f"the claims section, with its status there; the fit above spans all five Mn): "
+        lines += ["Delta at low Mn, from the particle part between the two lowest Mn (Delta = 1 - s, s its slope in "
+                  "the claims section, with its status there; the fit above spans all five Mn): "
                   + "; ".join(low_d) + ".", ""]
     lines += theory_and_experiment(crit, phi, expt, aqs_quote)
     low = low_mn(argv, here, crit, phi, aqs_quote, rows)

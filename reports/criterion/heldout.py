@@ -26,7 +26,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from paper_study import steady  # noqa: E402  (the drift and MSER tests of every point)
+from paper_rules import steady  # noqa: E402  (the drift and MSER tests of every point)
 from study import num, read_rows, save  # noqa: E402
 
 SWEEPS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "experiments", "sweeps")
