@@ -239,15 +239,35 @@ def drift_signs(runs):
     return k, n, min(1.0, 2 * tail)
 
 
-def low_mn(argv, here, crit, phi, aqs_quote, main_rows=()):
-    """Model 1 at Mn 3e-4 (experiments/sweeps/paper_low_mn.toml), read as that
-    file fixed before its runs: the particle part's slope s from Mn 1e-3
-    (the realistic sweep's point) within 2 standard errors of 0 is a
-    plateau, above it a fall toward the quasi-static value, below a rise."""
+def seed_combined(rows, phi, particle_part=True):
+    """The seed mean of runs of one point in phi mu0 M^2 (the particle part,
+    or the total), its error max(within-run combined for the mean, seed
+    scatter / sqrt(n)), and those two: (mean, err, within, scatter)."""
+    n = len(rows)
+    sc = [phi * MU0 * num(r, "magnetization") ** 2 for r in rows]
+    vals = [(num(r, "stress_total") - (num(r, "stress_fluid") if particle_part else 0.0)) / c
+            for r, c in zip(rows, sc)]
+    within = math.sqrt(sum((num(r, "stress_total_err") / c) ** 2 for r, c in zip(rows, sc))) / n
+    scatter = statistics.stdev(vals) / math.sqrt(n) if n > 1 else 0.0
+    return sum(vals) / n, max(within, scatter), within, scatter
+
+
+def low_mn_rows(argv, here):
+    """Model 1's finished runs of experiments/sweeps/paper_low_mn.toml."""
     path = arg(argv, "--low-mn", os.path.join(here, "study", "paper", "low_mn_sweep.csv"))
     if not os.path.exists(path):
+        return None
+    return [r for r in read_rows(path) if r["status"] == "ok" and r["model"] == "dem_stokes"]
+
+
+def low_mn(rows, crit, phi, aqs_quote, main_rows=()):
+    """Model 1 at Mn 3e-4 (experiments/sweeps/paper_low_mn.toml; rows from
+    low_mn_rows, None without its table), read as that file fixed before its
+    runs: the particle part's slope s from Mn 1e-3 (the realistic sweep's
+    point) within 2 standard errors of 0 is a plateau, above it a fall toward
+    the quasi-static value, below a rise."""
+    if rows is None:
         return []
-    rows = [r for r in read_rows(path) if r["status"] == "ok" and r["model"] == "dem_stokes"]
     base = next((q for q in crit["models"].get("dem_stokes", {}).get("points", []) if mkey(q["mason"]) == 1e-3), None)
     lines = ["## Model 1 below Mn 1e-3: is there a plateau?", "",
              "experiments/sweeps/paper_low_mn.toml: model 1, Mn = 3e-4 on the realistic path, three seeds; its "
@@ -259,13 +279,7 @@ def low_mn(argv, here, crit, phi, aqs_quote, main_rows=()):
     if not rows or base is None:
         return lines + [f"No run has finished yet ({len(rows)} of 3).", ""]
     n = len(rows)
-    sc = [phi * MU0 * num(r, "magnetization") ** 2 for r in rows]
-    vals = [(num(r, "stress_total") - num(r, "stress_fluid")) / c for r, c in zip(rows, sc)]
-    errs = [num(r, "stress_total_err") / c for r, c in zip(rows, sc)]
-    mean = sum(vals) / n
-    within = math.sqrt(sum(e * e for e in errs)) / n
-    scatter = statistics.stdev(vals) / math.sqrt(n) if n > 1 else 0.0
-    err = max(within, scatter)
+    mean, err, within, scatter = seed_combined(rows, phi)
     bs = phi * MU0 * base["magnetization"] ** 2
     bv, be = (base["stress"] - base["stress_fluid"]) / bs, base["err"] / bs
     lr = math.log(1e-3 / 3e-4)

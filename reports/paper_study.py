@@ -72,8 +72,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from paper_rules import (DRIFT_Z, MIN_INDEPENDENT, MSER_MAX, arg, coupled_open_at, fe, low_mn, lowest_slopes,  # noqa: E402
-                         mkey, old_claims, particle_note, particle_rule, particle_state, slope_status, steady)
+from paper_rules import (DRIFT_Z, MIN_INDEPENDENT, MSER_MAX, arg, coupled_open_at, fe, low_mn,  # noqa: E402
+                         low_mn_rows, lowest_slopes, mkey, old_claims, particle_note, particle_rule,
+                         particle_state, seed_combined, slope_status, steady)
 from study import (CHAIN_YIELD, COLOR, GINDER_SAT, LABEL, MN_CONVENTION, MU0, ORDER,  # noqa: E402
                    experiment_points, num, read_rows, save, strain_bin)
 
@@ -416,19 +417,12 @@ def main(argv):
             axs[0].errorbar(xs, [small[k][m][0] / (phi * MU0 * small_m ** 2) for m in xs],
                             yerr=[small[k][m][1] / (phi * MU0 * small_m ** 2) for m in xs], fmt="x:", ms=4,
                             capsize=2, color=COLOR[k], alpha=0.6, label=LABEL[k] + " (small cell, fixed M)")
-    low_path = arg(argv, "--low-mn", os.path.join(here, "study", "paper", "low_mn_sweep.csv"))
-    low_rows = ([r for r in read_rows(low_path) if r["status"] == "ok" and r["model"] == "dem_stokes"]
-                if os.path.exists(low_path) else [])
-    if low_rows:  # model 1 below Mn 1e-3 (its section): seed mean, error max(within, scatter / sqrt(n))
-        n = len(low_rows)
-        sc = [phi * MU0 * num(r, "magnetization") ** 2 for r in low_rows]
-        errs = [num(r, "stress_total_err") / c for r, c in zip(low_rows, sc)]
-        for ax, part in ((axs[0], lambda r: num(r, "stress_total")),
-                         (axs[1], lambda r: num(r, "stress_total") - num(r, "stress_fluid"))):
-            vals = [part(r) / c for r, c in zip(low_rows, sc)]
-            err = max(math.sqrt(sum(e * e for e in errs)) / n, statistics.stdev(vals) / math.sqrt(n) if n > 1 else 0)
-            ax.errorbar([num(low_rows[0], "mason")], [sum(vals) / n], yerr=[err], fmt="D", mfc="none", ms=5,
-                        capsize=3, color=COLOR["dem_stokes"], label=f"{LABEL['dem_stokes']} below Mn 1e-3 ({n} seeds)")
+    low_rows = low_mn_rows(argv, here)
+    if low_rows:  # model 1 below Mn 1e-3 (its section)
+        for ax, particle_part in ((axs[0], False), (axs[1], True)):
+            mean, err, _, _ = seed_combined(low_rows, phi, particle_part)
+            ax.errorbar([num(low_rows[0], "mason")], [mean], yerr=[err], fmt="D", mfc="none", ms=5, capsize=3,
+                        color=COLOR["dem_stokes"], label=f"{LABEL['dem_stokes']} below Mn 1e-3 ({len(low_rows)} seeds)")
     for ax in axs:
         if qs:  # the quoted AQS value (mean of the seeds) at the left edge, every run as its spread
             v, e, n_seeds = aqs_quote
@@ -477,9 +471,9 @@ def main(argv):
               "times where it is known: read it as a lower bound); "
               "particle part = total - fluid part (model 1: eta gdot exactly). Small cell: the default study "
               "(375 spheres, fixed M = 1e6 A/m), same Mn; difference in combined standard errors. The two cells "
-              "differ in path as well as in size: at Mn >= 0.1 the path alone moves the paper cell's stress by 5-52 "
-              "combined standard errors (section \"Two paths to a Mason number\"), so there the difference is "
-              "not the box's. Ratio column: seed scatter / sqrt(n) against the runs' combined within-run error, "
+              "differ in path as well as in size: at Mn >= 0.1 the path alone moves the paper cell's stress beyond "
+              "its error bars (section \"Two paths to a Mason number\"), so there the difference is not the "
+              "box's. Ratio column: seed scatter / sqrt(n) against the runs' combined within-run error, "
               "both errors of the mean (above 1 the seed scatter sets the error).", "",
               "| model | Mn | seeds | total | particle part | seed scatter / within-run | small cell total | "
               "paper - small (sigma) |", "|---|---:|---:|---:|---:|---:|---:|---:|"]
@@ -712,7 +706,7 @@ def main(argv):
                   "the claims section, with its status there; the fit above spans all five Mn): "
                   + "; ".join(low_d) + ".", ""]
     lines += theory_and_experiment(crit, phi, expt, aqs_quote)
-    low = low_mn(argv, here, crit, phi, aqs_quote, rows)
+    low = low_mn(low_rows, crit, phi, aqs_quote, rows)
     lines += low
     small_crit_path = arg(argv, "--small-criterion", os.path.join(here, "study", "criterion_default.json"))
     small_crit = json.load(open(small_crit_path)) if os.path.exists(small_crit_path) else None

@@ -63,12 +63,12 @@ def total(k, mn):
 
 
 def open_mn_failures(root, work):
-    """coupled_open_at (reports/paper_study.py), the rule of
+    """coupled_open_at (reports/paper_rules.py), the rule of
     paper_convergence.toml fixed in session 39: the coupled values at Mn 1e-3
     are results only with every coupled run there over 16-48 and both carrier
     rows in, neither beyond 2 combined standard errors of its base."""
     sys.path.insert(0, os.path.join(root, "reports"))
-    import paper_study  # noqa: E402
+    import paper_rules  # noqa: E402
     conv = os.path.join(work, "open_mn_points")
     m = math.sqrt(9 * ETA * GDOT / (2 * MU0 * 1e-3))
 
@@ -87,8 +87,8 @@ def open_mn_failures(root, work):
     out = []
 
     def expect(what, rows, want_open):
-        got = paper_study.coupled_open_at(conv, rows)
-        if (paper_study.mkey(1e-3) in got) != want_open:
+        got = paper_rules.coupled_open_at(conv, rows)
+        if (paper_rules.mkey(1e-3) in got) != want_open:
             out.append(f"open Mn 1e-3 rule: {what}: got {got}, want {'open' if want_open else 'closed'}")
 
     shutil.rmtree(conv, ignore_errors=True)
@@ -303,7 +303,7 @@ def main(argv):
             check(f"one-window bin {cells[col]} at strain {mid}", float(cells[col]),
                   tau1 + ONE_WINDOW_SLOPE * (mid - 32), 0.6)
         check("one-window second half, in its error", float(cells[8]), ONE_WINDOW_SLOPE * 8.05 / (0.005 * tau1), 0.06)
-    # (in the interpreter that has matplotlib, which paper_study imports)
+    # (in the interpreter that has matplotlib, which paper_rules imports through study.py)
     res = subprocess.run([py, os.path.abspath(__file__), "--open-mn", root, work], capture_output=True, text=True)
     failures += [x for x in res.stdout.splitlines() if x.startswith("open Mn 1e-3 rule")]
     if res.returncode != 0:
