@@ -41,7 +41,9 @@ GROUPS = [("paper_realistic", "dem_stokes", 0.1, 25), ("paper_mn01_states", "dem
           ("paper_realistic", "demsph_stokes", 1e-3, 4), ("paper_realistic", "demsph_dd", 1e-3, 4),
           ("paper_model1_seeds", "dem_stokes", 1e-3, 4), ("paper_realistic", "dem_stokes", 1e-3, 4),
           # Q1 of paper_model1_low_long.toml: its runs' 4-12 and 16-48 means from these 4-unit bins
-          ("paper_model1_low_long", "dem_stokes", 1e-3, 4), ("paper_model1_low_long", "dem_stokes", 3e-4, 4)]
+          ("paper_model1_low_long", "dem_stokes", 1e-3, 4), ("paper_model1_low_long", "dem_stokes", 3e-4, 4),
+          # the coupled models at Mn 1e-3 with the common EOS reference (paper_common_low.toml, session 40)
+          ("paper_common_low", "demsph_stokes", 1e-3, 4), ("paper_common_low", "demsph_dd", 1e-3, 4)]
 FIELDS = ["sweep", "model", "mason", "seed", "strain_lo", "strain_hi", "warmup_strain", "run_strain",
           "dipole_energy_per_sphere", "stress_total_Pa", "stress_particles_Pa", "stress_fluid_Pa"]
 
