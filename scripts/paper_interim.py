@@ -109,7 +109,18 @@ def merge_extra_seeds(mrf, toml, archive, out):
         return 0
     extra = out + "_" + os.path.basename(toml)[:-len(".toml")]
     shutil.rmtree(extra, ignore_errors=True)
-    subprocess.run([mrf, "sweep", toml, "--out", extra, "--archive", archive, "--collect", "--quiet"], check=True)
+    # its re-runs for steadiness (session 40) as the headline's: a point whose
+    # re-run is pending reads as its first run
+    tmp, src = os.path.join(os.path.dirname(toml), "_paper_interim_extra.toml"), toml
+    try:
+        if "# Re-runs for steadiness" in open(toml).read():
+            pending = interim_toml(toml, archive, tmp)
+            print(f"{os.path.basename(toml)[:-len('.toml')]}: re-runs pending: {', '.join(pending) if pending else 'none'}")
+            src = tmp
+        subprocess.run([mrf, "sweep", src, "--out", extra, "--archive", archive, "--collect", "--quiet"], check=True)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
     rows = open(os.path.join(extra, "sweep.csv")).read().splitlines()[1:]
     with open(os.path.join(out, "sweep.csv"), "a") as fh:
         fh.writelines(line + "\n" for line in rows)
