@@ -19,7 +19,9 @@ and reports/paper_model1_seeds.py shows every seed's window (and, beside
 model 3's point at Mn 0.1, never in it, the long runs of
 paper_mn01_long.toml by the reading fixed there)
 (reports/study/paper/model1_seeds.md); model 3 at Mn 0.1 takes those of
-paper_mn01_coupled_seeds.toml. reports/paper_tolerance.py applies
+paper_mn01_coupled_seeds.toml. An extra-seed sweep's own re-runs for
+steadiness (session 40) are read as the headline's: a point whose re-run
+is pending reads as its first run. reports/paper_tolerance.py applies
 the rules of experiments/sweeps/paper_tolerance.toml,
 paper_tolerance_coupled.toml and experiments/branch_tolerance.txt to their
 runs (reports/study/paper/tolerance.md).
