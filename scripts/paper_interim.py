@@ -90,10 +90,23 @@ def interim_toml(src_path, archive, out_path):
     return list(pending.values())
 
 
-def collect(mrf, toml, out, archive):
-    shutil.rmtree(out, ignore_errors=True)  # a clean collect: the archive is the record
-    subprocess.run([mrf, "sweep", toml, "--out", out, "--archive", archive, "--collect", "--quiet"], check=True)
-    subprocess.run([mrf, "criterion", out], check=True, stdout=subprocess.DEVNULL)
+def collect(mrf, toml, archive, out):
+    """`mrf sweep TOML --collect` from `archive` into a clean `out` (the
+    archive is the record). A sweep file with re-runs for steadiness is read
+    through interim_toml: a point whose re-run is pending reads as its first
+    run (the pending ones are printed)."""
+    shutil.rmtree(out, ignore_errors=True)
+    name = os.path.basename(toml)[:-len(".toml")]
+    tmp, src = os.path.join(os.path.dirname(toml), f"_{name}_interim.toml"), toml  # beside it: the scene path is relative
+    try:
+        if "# Re-runs for steadiness" in open(toml).read():
+            pending = interim_toml(toml, archive, tmp)
+            print(f"{name}: re-runs pending: {', '.join(pending) if pending else 'none'}")
+            src = tmp
+        subprocess.run([mrf, "sweep", src, "--out", out, "--archive", archive, "--collect", "--quiet"], check=True)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
 
 
 # Extra-seed sweeps of the headline (model 1, seeds 4-8; model 3 at Mn 0.1,
@@ -110,19 +123,7 @@ def merge_extra_seeds(mrf, toml, archive, out):
     if not os.path.isdir(archive):
         return 0
     extra = out + "_" + os.path.basename(toml)[:-len(".toml")]
-    shutil.rmtree(extra, ignore_errors=True)
-    # its re-runs for steadiness (session 40) as the headline's: a point whose
-    # re-run is pending reads as its first run
-    tmp, src = os.path.join(os.path.dirname(toml), "_paper_interim_extra.toml"), toml
-    try:
-        if "# Re-runs for steadiness" in open(toml).read():
-            pending = interim_toml(toml, archive, tmp)
-            print(f"{os.path.basename(toml)[:-len('.toml')]}: re-runs pending: {', '.join(pending) if pending else 'none'}")
-            src = tmp
-        subprocess.run([mrf, "sweep", src, "--out", extra, "--archive", archive, "--collect", "--quiet"], check=True)
-    finally:
-        if os.path.exists(tmp):
-            os.remove(tmp)
+    collect(mrf, toml, archive, extra)  # its re-runs for steadiness (session 40) read as the headline's
     rows = open(os.path.join(extra, "sweep.csv")).read().splitlines()[1:]
     with open(os.path.join(out, "sweep.csv"), "a") as fh:
         fh.writelines(line + "\n" for line in rows)
@@ -161,47 +162,31 @@ def main():
         src = {"paper_realistic": f"{paper}/points", "paper_fixed_m": f"{paper}/fixed_m_points",
                "paper_low_mn": f"{paper}/low_mn_points", "paper_convergence": f"{paper}/convergence/points"}
         src.update({n: f"{paper}/{a}" for n, a in EXTRA_SEEDS})
-    tmp = os.path.join(sweeps, "_paper_interim.toml")  # beside the others: the scene path is relative
-    try:
-        for name, archive, csv_name, crit_name in (
-                ("paper_realistic", src["paper_realistic"], "sweep.csv", "criterion.json"),
-                ("paper_fixed_m", src["paper_fixed_m"], "fixed_m_sweep.csv", "fixed_m_criterion.json")):
-            pending = interim_toml(os.path.join(sweeps, name + ".toml"), archive, tmp)
-            print(f"{name}: re-runs pending: {', '.join(pending) if pending else 'none'}")
-            out = os.path.join("out", "sweeps", name + "_interim")
-            collect(mrf, tmp, out, archive)
-            if name == "paper_realistic":
-                merged = 0
-                for extra, _ in EXTRA_SEEDS:
-                    n = merge_extra_seeds(mrf, os.path.join(sweeps, extra + ".toml"), src[extra], out)
-                    print(f"{extra}: {n} runs merged into the headline points")
-                    merged += n
-                if merged:
-                    subprocess.run([mrf, "criterion", out], check=True, stdout=subprocess.DEVNULL)
-            shutil.copy(os.path.join(out, "sweep.csv"), os.path.join(paper, csv_name))
-            shutil.copy(os.path.join(out, "criterion.json"), os.path.join(paper, crit_name))
-        n = reanalysed(mrf, src["paper_realistic"], os.path.join(paper, "reanalysed.json"))
-        print(f"paper_realistic: {n} runs re-analysed from their window series (runs that carry the version-2 "
-              "estimate need none; a run folder keeps no window series)")
-        # model 1 below Mn 1e-3 (no re-run rules: collected as it stands)
-        if os.path.isdir(src["paper_low_mn"]):
-            out = os.path.join("out", "sweeps", "paper_low_mn_interim")
-            shutil.rmtree(out, ignore_errors=True)
-            subprocess.run([mrf, "sweep", os.path.join(sweeps, "paper_low_mn.toml"), "--out", out, "--archive",
-                            src["paper_low_mn"], "--collect", "--quiet"], check=True)
-            shutil.copy(os.path.join(out, "sweep.csv"), os.path.join(paper, "low_mn_sweep.csv"))
-        # the convergence variants against the realistic path's seed means
-        pending = interim_toml(os.path.join(sweeps, "paper_convergence.toml"), src["paper_convergence"], tmp)
-        print(f"paper_convergence: re-runs pending: {', '.join(pending) if pending else 'none'}")
-        out = os.path.join("out", "sweeps", "paper_convergence_interim")
-        shutil.rmtree(out, ignore_errors=True)
-        subprocess.run([mrf, "sweep", tmp, "--out", out, "--archive", src["paper_convergence"], "--collect",
-                        "--quiet"], check=True)
-        subprocess.run(["/usr/bin/python3", "reports/paper_convergence.py", os.path.join(out, "sweep.csv"),
-                        os.path.join(paper, "sweep.csv"), os.path.join(paper, "convergence.md")], check=True)
-    finally:
-        if os.path.exists(tmp):
-            os.remove(tmp)
+    for name, archive, csv_name, crit_name in (
+            ("paper_realistic", src["paper_realistic"], "sweep.csv", "criterion.json"),
+            ("paper_fixed_m", src["paper_fixed_m"], "fixed_m_sweep.csv", "fixed_m_criterion.json")):
+        out = os.path.join("out", "sweeps", name + "_interim")
+        collect(mrf, os.path.join(sweeps, name + ".toml"), archive, out)
+        if name == "paper_realistic":
+            for extra, _ in EXTRA_SEEDS:
+                n = merge_extra_seeds(mrf, os.path.join(sweeps, extra + ".toml"), src[extra], out)
+                print(f"{extra}: {n} runs merged into the headline points")
+        subprocess.run([mrf, "criterion", out], check=True, stdout=subprocess.DEVNULL)
+        shutil.copy(os.path.join(out, "sweep.csv"), os.path.join(paper, csv_name))
+        shutil.copy(os.path.join(out, "criterion.json"), os.path.join(paper, crit_name))
+    n = reanalysed(mrf, src["paper_realistic"], os.path.join(paper, "reanalysed.json"))
+    print(f"paper_realistic: {n} runs re-analysed from their window series (runs that carry the version-2 "
+          "estimate need none; a run folder keeps no window series)")
+    # model 1 below Mn 1e-3 (no re-run rules: collected as it stands)
+    if os.path.isdir(src["paper_low_mn"]):
+        out = os.path.join("out", "sweeps", "paper_low_mn_interim")
+        collect(mrf, os.path.join(sweeps, "paper_low_mn.toml"), src["paper_low_mn"], out)
+        shutil.copy(os.path.join(out, "sweep.csv"), os.path.join(paper, "low_mn_sweep.csv"))
+    # the convergence variants against the realistic path's seed means
+    out = os.path.join("out", "sweeps", "paper_convergence_interim")
+    collect(mrf, os.path.join(sweeps, "paper_convergence.toml"), src["paper_convergence"], out)
+    subprocess.run(["/usr/bin/python3", "reports/paper_convergence.py", os.path.join(out, "sweep.csv"),
+                    os.path.join(paper, "sweep.csv"), os.path.join(paper, "convergence.md")], check=True)
     cmd = ["/usr/bin/python3", "reports/paper_study.py", "out/sweeps/paper_realistic_interim", paper,
            "--points", src["paper_realistic"]]
     if "--note" in sys.argv:
