@@ -109,8 +109,19 @@ def slope_status(k, lowest_mn, counts, open_mn):
     return ""
 
 
-def coupled_open_at(conv, rows):
-    """The Mn at which the coupled models' values are not yet results: at
+def common_in_headline(carrier):
+    """Whether the coupled points at Mn 1e-3 are the common-reference runs
+    (paper_common_low.toml): carrier holds the rows of
+    reports/study/paper/low_carrier.csv (scripts/paper_interim.py's
+    carrier_swap), which says which carrier's runs the headline holds."""
+    return any(r["carrier"] == "common" and r["in_headline"] == "yes" for r in carrier)
+
+
+def coupled_open_at(conv, rows, carrier=()):
+    """The Mn at which the coupled models' values are not yet results. Once
+    the common-reference runs stand in the headline (common_in_headline:
+    every point of paper_common_low.toml, the re-runs the rule below called
+    for, finished), none. Before: at
     Mn 1e-3, until every coupled run there is averaged over strain 16-48
     (paper_realistic.toml's one-window rule) and both coupled carrier rows
     (convergence variant eos_common_low) are in the convergence archive
@@ -119,7 +130,7 @@ def coupled_open_at(conv, rows):
     the points are to be run again with the common reference); a missing
     archive leaves it open. `conv` = "none" (a sweep with
     no carrier study, as the report's check builds): nothing is open."""
-    if conv == "none":
+    if conv == "none" or common_in_headline(carrier):
         return set()
     low = {k: [r for r in rows if r["model"] == k and mkey(r["mason"]) == 1e-3] for k in ("demsph_stokes", "demsph_dd")}
     windows = all((num(r, "warmup_strain"), num(r, "strain")) == (16.0, 48.0) for v in low.values() for r in v)

@@ -21,6 +21,8 @@ usage: paper_study.py SWEEP_DIR OUT_DIR [--small reports/study/flow_curves.csv]
                       [--reanalysed reports/study/paper/reanalysed.json]
                       [--convergence reports/study/paper/convergence.md]
                       [--low-mn reports/study/paper/low_mn_sweep.csv]
+                      [--carrier reports/study/paper/low_carrier.csv]
+                      [--common-points reports/study/paper/common_low/points]
 
 The fixed-M path (experiments/sweeps/paper_fixed_m.toml, collected with
 `mrf sweep ... --archive reports/study/paper/fixed_m_points --collect`, then
@@ -50,6 +52,10 @@ reading of the particle-part rule on runs that carry the plain estimate.
 --low-mn: model 1 at Mn 3e-4 (experiments/sweeps/paper_low_mn.toml, collected
 from reports/study/paper/low_mn_points by scripts/paper_interim.py), read
 by the rule that sweep file fixed before its runs.
+--carrier: the coupled runs at Mn 1e-3 under the per-particle carrier and
+the common EOS reference (scripts/paper_interim.py writes it; columns
+carrier and in_headline), tabulated side by side (reports/paper_carrier.py);
+--common-points: the archive of the common-reference runs (their bins).
 --convergence: the convergence table (reports/paper_convergence.py), whose
 largest-lever lines the opening section repeats.
 --small-criterion: mrf criterion's output for the small-cell study, whose
@@ -72,11 +78,12 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from paper_carrier import carrier_section, one_window  # noqa: E402
 from paper_rules import (DRIFT_Z, MIN_INDEPENDENT, MSER_MAX, arg, coupled_open_at, fe, low_mn,  # noqa: E402
                          low_mn_rows, lowest_slopes, mkey, old_claims, particle_note, particle_rule,
                          particle_state, seed_combined, slope_status, steady)
 from study import (CHAIN_YIELD, COLOR, GINDER_SAT, LABEL, MN_CONVENTION, MU0, ORDER,  # noqa: E402
-                   experiment_points, num, read_rows, save, strain_bin)
+                   experiment_points, num, read_rows, save)
 
 
 def post_hoc(argv, here, rows):
@@ -291,69 +298,10 @@ def theory_and_experiment(crit, phi, expt, aqs_quote):
     return lines
 
 
-def one_window(rows, firsts, phi, points):
-    """Session 34's one-window rule for the coupled models at Mn 1e-3, as it
-    asked to be reported: each point's seed mean before it (each seed's
-    short-window run if it has one, else its second run, else its entry: the
-    runs session 33's tables used) against the entries now, and their windows."""
-    earlier = defaultdict(dict)
-    for f in firsts:
-        earlier[(f["model"], int(f["seed"]))][f["run_number"]] = f
-    lines = []
-    for k in ("demsph_stokes", "demsph_dd"):
-        now = [r for r in rows if r["model"] == k and abs(float(r["mason"]) - 1e-3) < 1e-9]
-        if not now:
-            continue
-        before = []
-        for r in now:
-            e = earlier[(k, int(r["seed"]))]
-            before.append(e.get("w") or e.get(2) or r)
-        def line(label, runs):
-            vals = [num(x, "stress_total") for x in runs]
-            wins = ", ".join(f"{num(x, 'warmup_strain'):g}-{num(x, 'strain'):g}" for x in runs)
-            m, sd = statistics.mean(vals), (statistics.stdev(vals) if len(vals) > 1 else float("nan"))
-            return (f"| {k} | {label} | {wins} | {m:.0f} ± {sd / math.sqrt(len(vals)):.0f} | "
-                    f"{statistics.mean(num(x, 'stress_fluid') for x in runs):.0f} |")
-        if not lines:
-            lines = ["", "One window at Mn 1e-3 (session 34's rule, fixed before its runs): the coupled points' seed means "
-                     "before it, in mixed windows, against their entries now (Pa; ± the seed scatter's standard error). "
-                     "The rule's runs replace the 4-12 ones as they finish.", "",
-                     "| model | runs | windows (strain) | total wall stress | fluid part |", "|---|---|---|---:|---:|"]
-        lines += [line("session 33's", before), line("now", now)]
-    return lines + window_bins(rows, points)
-
-
-def window_bins(rows, points):
-    """How far the one-window runs (16-48) still move inside their window: the
-    total in 8-strain bins from each run's window_series.csv, and the second
-    half's mean against the window's, in the run's own standard error. A
-    description, not a test: the rule's verdict is the drift test's."""
-    out = []
-    for r in rows:
-        if abs(float(r["mason"]) - 1e-3) > 1e-9 or (num(r, "warmup_strain"), num(r, "strain")) != (16.0, 48.0):
-            continue
-        path = os.path.join(points, r["model"], f"mn_{float(r['mason']):g}_seed_{int(r['seed'])}", "window_series.csv")
-        if not os.path.exists(path):
-            continue
-        series = read_rows(path)
-        whole, err = num(r, "stress_total"), num(r, "stress_total_err")
-        late = strain_bin(series, "stress_total_Pa", 32, 48)
-        out.append(f"| {r['model']} | {r['seed']} | {whole:.0f} ± {err:.0f} | "
-                   + " | ".join(f"{strain_bin(series, 'stress_total_Pa', lo, lo + 8):.0f}" for lo in (16, 24, 32, 40))
-                   + f" | {late:.0f} | {(late - whole) / err:+.1f} |")
-    if not out:
-        return []
-    return ["", "Inside the one window (strain 16-48), each run's total wall stress in 8-strain bins (Pa, plain means "
-            "of its window_series.csv) and the mean over the second half (32-48) against the window's, in the run's "
-            "own standard error: how far the value still moves with the window's start. A description, not a "
-            "test (the rule's verdict is the drift test above).", "",
-            "| model | seed | 16-48 (the rule's) | 16-24 | 24-32 | 32-40 | 40-48 | 32-48 | (32-48) - (16-48), in its error |",
-            "|---|---:|---:|---:|---:|---:|---:|---:|---:|"] + out
-
-
-def sweep_cost(rows, firsts):
+def sweep_cost(rows, firsts, beside=()):
     """The wall time of the whole sweep: every run that counts, plus the
-    first runs (summaries) that the steadiness re-runs replaced."""
+    first runs (summaries) that the steadiness re-runs replaced and the
+    runs of the carrier the headline does not hold (`beside`)."""
     per = defaultdict(float)
     for r in rows:
         per[r["model"]] += num(r, "wall_seconds")
@@ -361,15 +309,18 @@ def sweep_cost(rows, firsts):
     # an earlier run counts only once a re-run (another strain) has replaced it
     firsts = [f for f in firsts if current.get((f["model"], float(f["mason"]), int(f["seed"]))) not in (None, f["strain"])]
     first = sum(f.get("wall_seconds", 0.0) for f in firsts)
-    total = sum(per.values()) + first
+    other = sum(num(r, "wall_seconds") for r in beside)
+    total = sum(per.values()) + first + other
     timed = [r for r in rows if num(r, "cpu_seconds") > 0]  # runs of checkpoint format 10 on record their CPU time
     cpu = (f" CPU time, which leaves out pauses and the other jobs on the cores, is on record for {len(timed)} of the "
            f"runs counted: {sum(num(r, 'cpu_seconds') for r in timed) / 3600:.2f} core-hours against their "
            f"{sum(num(r, 'wall_seconds') for r in timed) / 3600:.2f} h of wall time." if timed else "")
     return ["Whole-sweep wall time (one thread per run, summed over runs; shared machine, an upper bound): "
             + ", ".join(f"{k} {per[k] / 3600:.1f} h" for k in ORDER if k in per)
-            + f", the earlier runs replaced by re-runs {first / 3600:.1f} h; **{total / 3600:.1f} core-hours** in all "
-            f"({len(rows)} runs counted, {len(firsts)} replaced)." + cpu, ""]
+            + f", the earlier runs replaced by re-runs {first / 3600:.1f} h"
+            + (f", the other carrier's runs at Mn 1e-3 {other / 3600:.1f} h" if beside else "")
+            + f"; **{total / 3600:.1f} core-hours** in all ({len(rows)} runs counted, {len(firsts)} replaced"
+            + (f", {len(beside)} beside" if beside else "") + ")." + cpu, ""]
 
 
 def main(argv):
@@ -381,6 +332,9 @@ def main(argv):
     small_path = arg(argv, "--small", os.path.join(here, "study", "flow_curves.csv"))
     os.makedirs(out, exist_ok=True)
     rows = [r for r in read_rows(os.path.join(sweep_dir, "sweep.csv")) if r["status"] == "ok"]
+    # the coupled runs at Mn 1e-3 under both carriers (scripts/paper_interim.py's carrier_swap)
+    carrier_path = arg(argv, "--carrier", os.path.join(here, "study", "paper", "low_carrier.csv"))
+    carrier = [r for r in read_rows(carrier_path) if r["status"] == "ok"] if os.path.exists(carrier_path) else []
     crit = json.load(open(os.path.join(sweep_dir, "criterion.json")))
     phi = crit["volume_fraction"]
     models = [k for k in ORDER if k in crit["models"]]
@@ -568,11 +522,15 @@ def main(argv):
                          f"{f['strain']:g} ({f['warmup_strain']:g}) | "
                          f"{f['stress_total_drift_z']:+.2f} | {f['steady_mser_discard_fraction']:.3f} | "
                          f"{'yes' if ok else '**no**'} | {state} |")
-    lines += one_window(rows, firsts, phi, arg(argv, "--points", os.path.join(here, "study", "paper", "points")))
+    # the one-window rule's runs are the per-particle ones, in the headline or beside it (the carrier section)
+    pp_low = [r for r in carrier if r["carrier"] == "per_particle"] or rows
+    lines += one_window(pp_low, firsts, phi, arg(argv, "--points", os.path.join(here, "study", "paper", "points")))
+    lines += carrier_section(carrier, arg(argv, "--common-points", os.path.join(here, "study", "paper", "common_low",
+                                                                                  "points")))
     lines += ["", "Cost: wall seconds per strain unit of each run, one thread, on a shared 2-core machine "
               "(the sweep ran at nice 19 beside other work: an upper bound, not a benchmark; "
               "reports/performance/model_ratios.md has the side-by-side ratios).", ""]
-    lines += sweep_cost(rows, firsts)
+    lines += sweep_cost(rows, firsts, [r for r in carrier if r["in_headline"] == "no"])
     # cost per strain unit per model and Mn: the fastest seed (the least
     # disturbed by other jobs), and its ratio to model 1's at the same Mn
     per = defaultdict(list)
@@ -692,7 +650,7 @@ def main(argv):
     # part is tau - eta_inf gdot, so Delta = 1 - s of the particle part
     # between the two lowest Mn (the claims section's slope)
     conv_points = arg(argv, "--convergence-points", os.path.join(here, "study", "paper", "convergence", "points"))
-    open_mn, pstates, low_d = coupled_open_at(conv_points, rows), particle_state(rows), []
+    open_mn, pstates, low_d = coupled_open_at(conv_points, rows, carrier), particle_state(rows), []
     for k in models:
         p = sorted(crit["models"][k]["points"], key=lambda q: q["mason"])
         sl = lowest_slopes(p, lambda q: phi * MU0 * q["magnetization"] ** 2)[1] if len(p) >= 2 else None

@@ -21,24 +21,30 @@ paper_mn01_long.toml by the reading fixed there)
 (reports/study/paper/model1_seeds.md); model 3 at Mn 0.1 takes those of
 paper_mn01_coupled_seeds.toml. An extra-seed sweep's own re-runs for
 steadiness (session 40) are read as the headline's: a point whose re-run
-is pending reads as its first run. reports/paper_tolerance.py applies
+is pending reads as its first run. The coupled points at Mn 1e-3 become
+the common-reference runs of paper_common_low.toml once all six are in
+(carrier_swap; reports/study/paper/low_carrier.csv holds both carriers'
+runs there), while the convergence table keeps the per-particle headline
+as its base. reports/paper_tolerance.py applies
 the rules of experiments/sweeps/paper_tolerance.toml,
 paper_tolerance_coupled.toml and experiments/branch_tolerance.txt to their
 runs (reports/study/paper/tolerance.md).
 
-With --runs the ten sweeps are read from their run folders
+With --runs the eleven sweeps are read from their run folders
 (out/sweeps/<sweep name>, laid out as an archive is) instead of the
 committed archives: what `scripts/reproduce paper` does after running them
 from scratch.
 
 usage: scripts/paper_interim.py [--mrf build/mrf] [--note TEXT] [--runs]
 """
+import csv
 import json
 import os
 import re
 import shutil
 import subprocess
 import sys
+import tomllib
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 GRID = [1e-3, 1e-2, 0.1, 1.0, 10.0]
@@ -130,6 +136,47 @@ def merge_extra_seeds(mrf, toml, archive, out):
     return len(rows)
 
 
+def carrier_rows(head, common, n_design):
+    """The headline's rows and low_carrier.csv's (see carrier_swap) from the
+    collected headline `head` and the finished common-reference runs
+    `common` (rows as dicts), of a design of n_design runs: (headline,
+    table, swapped?). The headline takes the common runs in place of its
+    coupled rows at Mn 1e-3 only once all n_design are in."""
+    low = lambda r: r["model"] in ("demsph_stokes", "demsph_dd") and abs(float(r["mason"]) - 1e-3) < 1e-9  # noqa: E731
+    swap = len(common) == n_design
+    table = ([dict(r, carrier="per_particle", in_headline="no" if swap else "yes") for r in head if low(r)]
+             + [dict(r, carrier="common", in_headline="yes" if swap else "no") for r in common])
+    return ([r for r in head if not low(r)] + common if swap else head), table, swap
+
+
+def carrier_swap(mrf, toml, archive, out, table):
+    """The coupled points at Mn 1e-3 under the common EOS reference
+    (experiments/sweeps/paper_common_low.toml, the re-runs that
+    paper_convergence.toml's session-39 rule called for). Collects the
+    sweep from `archive`; once every point of its design has finished, the
+    collected headline in `out` (sweep.csv) takes these runs in place of
+    its coupled rows at Mn 1e-3 (its `mrf criterion` is to be run after).
+    Writes `table`: the coupled rows at Mn 1e-3 of both carriers, with
+    columns carrier (per_particle, common) and in_headline (yes, no).
+    Returns (finished runs, runs of the design, swapped?)."""
+    head_path = os.path.join(out, "sweep.csv")
+    header = open(head_path).readline().strip().split(",")
+    common = []
+    if os.path.isdir(archive):
+        collect(mrf, toml, archive, out + "_paper_common_low")
+        common = [r for r in csv.DictReader(open(os.path.join(out + "_paper_common_low", "sweep.csv")))
+                  if r["status"] == "ok"]
+    design = tomllib.load(open(toml, "rb"))["sweep"]
+    n_design = len(design["models"]) * len(design["mason"]) * len(design["seeds"])
+    head, rows, swap = carrier_rows(list(csv.DictReader(open(head_path))), common, n_design)
+    for path, cols, data in ((head_path, header, head), (table, header + ["carrier", "in_headline"], rows)):
+        with open(path, "w", newline="") as fh:
+            w = csv.DictWriter(fh, cols, lineterminator="\n")
+            w.writeheader()
+            w.writerows(data)
+    return len(common), n_design, swap
+
+
 def reanalysed(mrf, archive, out_path):
     """`mrf reanalyse` on every archive entry that keeps its window series
     (window_series.csv), one record per run with its model, Mn and seed:
@@ -154,13 +201,16 @@ def main():
     mrf = arg("--mrf", "build/mrf")
     paper = "reports/study/paper"
     sweeps = "experiments/sweeps"
+    per_particle = os.path.join("out", "sweeps", "paper_realistic_interim_per_particle.csv")
     # where each sweep's finished points are read from
     if "--runs" in sys.argv:
-        names = ["paper_realistic", "paper_fixed_m", "paper_low_mn", "paper_convergence"] + [n for n, _ in EXTRA_SEEDS]
+        names = ["paper_realistic", "paper_fixed_m", "paper_low_mn", "paper_convergence", "paper_common_low"] + [
+            n for n, _ in EXTRA_SEEDS]
         src = {n: os.path.join("out", "sweeps", n) for n in names}
     else:
         src = {"paper_realistic": f"{paper}/points", "paper_fixed_m": f"{paper}/fixed_m_points",
-               "paper_low_mn": f"{paper}/low_mn_points", "paper_convergence": f"{paper}/convergence/points"}
+               "paper_low_mn": f"{paper}/low_mn_points", "paper_convergence": f"{paper}/convergence/points",
+               "paper_common_low": f"{paper}/common_low/points"}
         src.update({n: f"{paper}/{a}" for n, a in EXTRA_SEEDS})
     for name, archive, csv_name, crit_name in (
             ("paper_realistic", src["paper_realistic"], "sweep.csv", "criterion.json"),
@@ -171,6 +221,12 @@ def main():
             for extra, _ in EXTRA_SEEDS:
                 n = merge_extra_seeds(mrf, os.path.join(sweeps, extra + ".toml"), src[extra], out)
                 print(f"{extra}: {n} runs merged into the headline points")
+            # the convergence table's base stays the per-particle carrier (its rows are variants of it)
+            shutil.copy(os.path.join(out, "sweep.csv"), per_particle)
+            done, n, swap = carrier_swap(mrf, os.path.join(sweeps, "paper_common_low.toml"), src["paper_common_low"],
+                                         out, os.path.join(paper, "low_carrier.csv"))
+            print(f"paper_common_low: {done} of {n} runs finished; the coupled points at Mn 1e-3 are "
+                  + ("the common reference's" if swap else "the per-particle carrier's until all are in"))
         subprocess.run([mrf, "criterion", out], check=True, stdout=subprocess.DEVNULL)
         shutil.copy(os.path.join(out, "sweep.csv"), os.path.join(paper, csv_name))
         shutil.copy(os.path.join(out, "criterion.json"), os.path.join(paper, crit_name))
@@ -186,7 +242,7 @@ def main():
     out = os.path.join("out", "sweeps", "paper_convergence_interim")
     collect(mrf, os.path.join(sweeps, "paper_convergence.toml"), src["paper_convergence"], out)
     subprocess.run(["/usr/bin/python3", "reports/paper_convergence.py", os.path.join(out, "sweep.csv"),
-                    os.path.join(paper, "sweep.csv"), os.path.join(paper, "convergence.md")], check=True)
+                    per_particle, os.path.join(paper, "convergence.md")], check=True)
     cmd = ["/usr/bin/python3", "reports/paper_study.py", "out/sweeps/paper_realistic_interim", paper,
            "--points", src["paper_realistic"]]
     if "--note" in sys.argv:

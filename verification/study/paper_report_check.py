@@ -100,6 +100,32 @@ def open_mn_failures(root, work):
     expect("a 12-unit window left", base[:-1] + [run("demsph_dd", 103.0, 3, (4, 12))], True)
     carrier("demsph_dd", 105.5)  # +2.47 sigma
     expect("a row beyond 2 sigma", base, True)
+    # the re-runs that outcome calls for (paper_common_low.toml): the rule
+    # closes once the headline holds them, which scripts/paper_interim.py's
+    # carrier_rows makes so only when the whole design is in
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("paper_interim", os.path.join(root, "scripts", "paper_interim.py"))
+    interim = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(interim)
+    others = [dict(run("dem_stokes", 50.0, sd), status="ok") for sd in (1, 2, 3)]
+    head = others + [dict(r, status="ok") for r in base]
+    common = [dict(run(k, 110.0 + sd, sd), status="ok") for k in ("demsph_stokes", "demsph_dd") for sd in (1, 2, 3)]
+    for n_in, want_swap in ((5, False), (6, True)):
+        new_head, table, swap = interim.carrier_rows(head, common[:n_in], 6)
+        coupled = sorted(r["stress_total"] for r in new_head if r["model"] != "dem_stokes")
+        want_coupled = sorted(r["stress_total"] for r in (common if want_swap else base))
+        flags = sorted({(r["carrier"], r["in_headline"]) for r in table})
+        want_flags = sorted([("per_particle", "no"), ("common", "yes")] if want_swap
+                            else [("per_particle", "yes"), ("common", "no")])
+        if (swap != want_swap or coupled != want_coupled or len(table) != 6 + n_in or flags != want_flags
+                or [r for r in new_head if r["model"] == "dem_stokes"] != others):
+            out.append(f"open Mn 1e-3 rule: carrier_rows with {n_in} of 6 common runs: swap {swap}, "
+                       f"{len(table)} table rows, flags {flags}")
+        # the rule reads the table: the outcome above stands until the swap
+        got = paper_rules.coupled_open_at(conv, new_head, table)
+        if (paper_rules.mkey(1e-3) in got) == want_swap:
+            out.append(f"open Mn 1e-3 rule: {n_in} of 6 common-reference runs in: got {got}, "
+                       f"want {'closed' if want_swap else 'open'}")
     return out
 
 
@@ -167,9 +193,9 @@ def main(argv):
             g = 16 + 0.1 * i
             w.writerow([g / GDOT, g, repr(tau1 + ONE_WINDOW_SLOPE * (g - 32))])
 
-    def report(out_dir, low, convergence="none"):
+    def report(out_dir, low, convergence="none", carrier=none):
         subprocess.run([py, os.path.join(root, "reports", "paper_study.py"), sweep, out_dir,
-                        "--points", os.path.join(work, "points"),
+                        "--points", os.path.join(work, "points"), "--carrier", carrier, "--common-points", none,
                         "--small", none, "--quasistatic", none, "--fixed-m", none, "--first-runs", none,
                         "--small-criterion", os.path.join(sweep, "criterion.json"), "--reanalysed", late,
                         "--low-mn", low, "--convergence-points", convergence], check=True, stdout=subprocess.DEVNULL)
@@ -287,6 +313,27 @@ def main(argv):
         failures.append(f"{len(lows)} lowest-Mn rows in the theory section, want {len(MODELS)}")
     for line, (k, (c, _)) in zip(lows, MODELS.items()):
         check(f"theory section, {k} particle part", float(value.match(line.split("|")[2].strip()).group(1)), c, 1e-4)
+    # The two carriers at Mn 1e-3 (reports/paper_carrier.py): model 3's
+    # per-particle seeds at 100, 101, 102 Pa (within-run error 1), its common
+    # ones at 110, 111, 112 (0.5). Seed means 101 and 111, errors max(within,
+    # SD / sqrt 3): 1 and 1 / sqrt 3, so +9.9 % and 10 / hypot(1, 1 / sqrt 3)
+    # = +8.7 combined errors.
+    carrier_csv = os.path.join(work, "low_carrier.csv")
+    with open(carrier_csv, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(COLUMNS + ["carrier", "in_headline"])
+        for c, base, err, head in (("per_particle", 100.0, 1.0, "yes"), ("common", 110.0, 0.5, "no")):
+            for seed in (1, 2, 3):
+                w.writerow(["demsph_dd", 1e-3, seed, "ok", GDOT, 48, 16, repr(base + seed - 1), repr(err), 0.1, 0.0,
+                            50.0, repr(base), 4125, 100.0, 1e-4, 6e-5, 1e5, PHI, ETA, 1000.0, 1.5e-4, 2.5e-6, 1, "",
+                            0.5, "", c, head])
+    md_carrier = report(os.path.join(work, "report_carrier"), low_mn_csv("low_flat.csv", 1.0), carrier=carrier_csv)
+    want = "Common against per-particle, seed mean against seed mean: demsph_dd +9.9 % (+8.7 combined errors)."
+    if want not in md_carrier:
+        failures.append("carrier section: " + str([x for x in md_carrier.splitlines() if x.startswith("Common against")])
+                        + f", want {want}")
+    if "## The carrier at Mn 1e-3" in md:
+        failures.append("carrier section: written for a report without common-reference runs")
     for text, want in ((md, "**is flat (a plateau)**"), (md_fall, "**falls toward the quasi-static value**")):
         line = [x for x in text.splitlines() if x.startswith("s (3e-4 to 1e-3)")]
         if not line or want not in line[0]:
@@ -294,15 +341,15 @@ def main(argv):
     # The one-window run's bins (the line at each bin's middle) and its second
     # half against the row's stress, in the row's error (0.5 %).
     sect = md.split("Inside the one window")[1].split("\n\n", 2)[1] if "Inside the one window" in md else ""
-    hit = [x for x in sect.splitlines() if x.startswith(f"| {ONE_WINDOW[0]} | {ONE_WINDOW[2]} | ")]
+    hit = [x for x in sect.splitlines() if x.startswith(f"| {ONE_WINDOW[0]} | per_particle | {ONE_WINDOW[2]} | ")]
     if len(hit) != 1:
         failures.append(f"one-window bins: {len(hit)} rows for {ONE_WINDOW}, want 1")
     else:
         cells = [x.strip() for x in hit[0].strip("|").split("|")]
-        for col, mid in zip(range(3, 8), (20.05, 28.05, 36.05, 44.05, 40.05)):
+        for col, mid in zip(range(4, 9), (20.05, 28.05, 36.05, 44.05, 40.05)):
             check(f"one-window bin {cells[col]} at strain {mid}", float(cells[col]),
                   tau1 + ONE_WINDOW_SLOPE * (mid - 32), 0.6)
-        check("one-window second half, in its error", float(cells[8]), ONE_WINDOW_SLOPE * 8.05 / (0.005 * tau1), 0.06)
+        check("one-window second half, in its error", float(cells[9]), ONE_WINDOW_SLOPE * 8.05 / (0.005 * tau1), 0.06)
     # (in the interpreter that has matplotlib, which paper_rules imports through study.py)
     res = subprocess.run([py, os.path.abspath(__file__), "--open-mn", root, work], capture_output=True, text=True)
     failures += [x for x in res.stdout.splitlines() if x.startswith("open Mn 1e-3 rule")]
