@@ -94,6 +94,11 @@ for model, got in rows:
                      f"{t1 / t2:.2f} |")
 lines += ["", "Median ratio per model: " + "; ".join(
     f"{model} {statistics.median(a[0] / b[0] for a, b in got):.2f}x" for model, got in rows) + "."]
+one = {model: statistics.median(a[0] for a, _ in got) for model, got in rows}
+if "dem_stokes" in one:
+    lines += ["", "One thread, median time per strain unit against model 1's (issue 12's coupled / model 1 in the "
+              "steady state): " + "; ".join(f"{m} {one[m] / one['dem_stokes']:.1f}x" for m in one if m != "dem_stokes")
+              + "."]
 report = root / "reports" / "performance" / ("steady_threads_quick.md" if quick else "steady_threads.md")
 report.parent.mkdir(parents=True, exist_ok=True)
 report.write_text("\n".join(lines) + "\n")
