@@ -24,7 +24,7 @@ def one_window(rows, firsts, phi, points):
     for f in firsts:
         earlier[(f["model"], int(f["seed"]))][f["run_number"]] = f
     lines = []
-    for k in ("demsph_stokes", "demsph_dd"):
+    for k in COUPLED:
         now = [r for r in rows if r["model"] == k and abs(float(r["mason"]) - 1e-3) < 1e-9]
         if not now:
             continue

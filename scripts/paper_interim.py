@@ -244,7 +244,7 @@ def main():
     subprocess.run(["/usr/bin/python3", "reports/paper_convergence.py", os.path.join(out, "sweep.csv"),
                     per_particle, os.path.join(paper, "convergence.md")], check=True)
     cmd = ["/usr/bin/python3", "reports/paper_study.py", "out/sweeps/paper_realistic_interim", paper,
-           "--points", src["paper_realistic"]]
+           "--points", src["paper_realistic"], "--common-points", src["paper_common_low"]]
     if "--note" in sys.argv:
         cmd += ["--note", arg("--note", "")]
     subprocess.run(cmd, check=True)
