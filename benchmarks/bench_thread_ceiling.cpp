@@ -5,8 +5,9 @@
 // a compute-bound form (independent multiply-add chains, no memory traffic)
 // and a memory-bound one (a triad over arrays of 32 KiB to 32 MiB a vector).
 // The ratio t(1 thread) / t(2 threads) of a row is the ceiling of a code
-// whose regions look like it: issue 16 asks 1.8x per strain unit, and a VM
-// whose second vCPU answers late caps it below that for any code.
+// whose regions look like it (issue 16 asks 1.8x per strain unit), and the
+// handoff case what a pass pays when the data it reads was last written by
+// the other thread (docs/performance.md, session 41).
 //
 //   build/benchmarks/bench_thread_ceiling --benchmark_filter=Ceiling
 //
