@@ -160,7 +160,8 @@ def carrier_swap(mrf, toml, archive, out, table):
     columns carrier (per_particle, common) and in_headline (yes, no).
     Returns (finished runs, runs of the design, swapped?)."""
     head_path = os.path.join(out, "sweep.csv")
-    header = open(head_path).readline().strip().split(",")
+    reader = csv.DictReader(open(head_path))
+    header, head = reader.fieldnames, list(reader)
     common = []
     if os.path.isdir(archive):
         collect(mrf, toml, archive, out + "_paper_common_low")
@@ -168,7 +169,7 @@ def carrier_swap(mrf, toml, archive, out, table):
                   if r["status"] == "ok"]
     design = tomllib.load(open(toml, "rb"))["sweep"]
     n_design = len(design["models"]) * len(design["mason"]) * len(design["seeds"])
-    head, rows, swap = carrier_rows(list(csv.DictReader(open(head_path))), common, n_design)
+    head, rows, swap = carrier_rows(head, common, n_design)
     for path, cols, data in ((head_path, header, head), (table, header + ["carrier", "in_headline"], rows)):
         with open(path, "w", newline="") as fh:
             w = csv.DictWriter(fh, cols, lineterminator="\n")
