@@ -1,11 +1,18 @@
 // The inertialess coupled scheme against the inertial one where the particle
-// Stokes number is small (small scene, Mn = 1e-2, St = 3e-3, model 3, three
+// Stokes number is small (small scene, Mn = 1e-2, St = 3e-3, model 3, six
 // seeds, strain 3 with 1 of warm-up): the wall stress and the volume-side
 // stress agree within 2 combined standard errors (seed scatter of the paired
 // differences with the within-run errors). scripts/coupled-agreement runs the
-// full comparison (models 2 and 3, Mn = 1e-2 and 0.1, six seeds) into
+// full comparison (models 2 and 3, Mn = 1e-2 and 0.1) into
 // reports/inertia/coupled_agreement.md. Label slow: the inertial runs take
-// about a minute each.
+// about 15 s each.
+//
+// Six seeds, as the issue asked, since session 42: with three the seed
+// scatter has two degrees of freedom and the verdict turned on one run's
+// within-run error. Over seeds 1-3 the Jacobian's C_J (session 42) gave
+// +604 +- 234 Pa (2.6 errors, failed) where the code before gave +598 +- 353
+// (1.7, passed): the same offset, a smaller error bar on seed 2. Over seeds
+// 1-12 both give +1.4 % (1.0 combined errors; docs/performance.md).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -29,7 +36,7 @@ RunSummary run(const char* integrator, int seed) {
 TEST(SlowCoupledAgreement, InertialessEqualsInertialAtSmallStokesNumber) {
   std::vector<double> dw, dv;
   double within_w = 0, within_v = 0, cost_inertial = 0, cost_inertialess = 0;
-  for (int seed : {1, 2, 3}) {
+  for (int seed : {1, 2, 3, 4, 5, 6}) {
     const RunSummary a = run("verlet_exp", seed), b = run("implicit", seed);
     ASSERT_EQ(b.integrator.rfind("inertialess", 0), 0u) << b.integrator;
     dw.push_back(b.stress_total.mean - a.stress_total.mean);

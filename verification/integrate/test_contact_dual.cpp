@@ -216,6 +216,62 @@ TEST(ContactDual, CoupledWallContactsOfOneSphereFactorExactly) {
   EXPECT_NEAR(f[0].x(), k * std::pow(left, 1.5) - k * std::pow(right, 1.5), 1e-9 * k * std::pow(left, 1.5));
 }
 
+// A coupling whose Jacobian is a cruder C (c_J = 0.6 c): the Newton
+// iteration must take its residuals with C itself and its linear solves with
+// C_J, so it lands on the same forces as with the exact Jacobian, the step's
+// equation holding with C. Taking the residual with C_J would break
+// y = b + (mob + s c) f by 0.4 s c f, 20x the drag part.
+class CrudeJacobianCoupling final : public MobilityCoupling {
+ public:
+  explicit CrudeJacobianCoupling(double c) : exact_(c), crude_(0.6 * c) {}
+  void add(const std::vector<Vec3>& f, double scale, std::vector<Vec3>& y,
+           const std::vector<std::uint32_t>* rows) override {
+    ++adds;
+    exact_.add(f, scale, y, rows);
+  }
+  void add_jacobian(const std::vector<Vec3>& f, double scale, std::vector<Vec3>& y,
+                    const std::vector<std::uint32_t>* rows) override {
+    ++jacobian_adds;
+    crude_.add(f, scale, y, rows);
+  }
+  double diagonal(std::size_t i) const override { return exact_.diagonal(i); }
+  double coupling(std::size_t i, std::size_t k) const override { return exact_.coupling(i, k); }
+  long adds = 0, jacobian_adds = 0;
+
+ private:
+  UniformCoupling exact_, crude_;
+};
+
+TEST(ContactDual, AnApproximateJacobianConvergesToTheSameForces) {
+  const double r = 1e-6, k = 1e4, mob = 1e-3, c = 5e4, s = 1e-6;
+  const Box box{10 * r, 10 * r, 10 * r};
+  WallParticles walls;
+  walls.x = {Vec3(-1.99 * r, 0, 0), Vec3(1.995 * r, 0, 0)};
+  walls.side = {-1, 1};
+  const std::vector<ContactPair> pairs = {{0, 0, true}, {0, 1, true}};
+  const std::vector<Vec3> x0 = {Vec3::Zero()}, b = {Vec3(2e-3 * r, 0, 0)};
+  NewtonOptions opt;
+  opt.tol = 1e-12 * r;
+  opt.max_iterations = 50;
+  opt.linear_rtol = 1e-12;
+  UniformCoupling exact(c);
+  CrudeJacobianCoupling crude(c);
+  std::vector<Vec3> y_exact, y_crude, f_exact(1, Vec3::Zero()), f_crude(1, Vec3::Zero());
+  ContactDual a, d;
+  const NewtonResult ra = a.solve(pairs, b, x0, walls, walls, box, r, k, {mob}, &exact, s, opt, y_exact);
+  const NewtonResult rd = d.solve(pairs, b, x0, walls, walls, box, r, k, {mob}, &crude, s, opt, y_crude);
+  ASSERT_TRUE(ra.converged);
+  ASSERT_TRUE(rd.converged) << "last correction " << rd.last_correction;
+  a.add_forces(pairs, f_exact);
+  d.add_forces(pairs, f_crude);
+  EXPECT_GT(crude.jacobian_adds, 0) << "the linear solves apply C_J";
+  EXPECT_GT(crude.adds, 0) << "the residuals apply C";
+  EXPECT_GT(rd.iterations, ra.iterations) << "a cruder Jacobian converges more slowly";
+  EXPECT_NEAR(y_crude[0].x(), b[0].x() + (mob + s * c) * f_crude[0].x(), 1e-9 * r);
+  EXPECT_NEAR(f_crude[0].x(), f_exact[0].x(), 1e-6 * std::abs(f_exact[0].x()));  // both to 1e-12 R in overlap
+  EXPECT_NEAR(y_crude[0].x(), y_exact[0].x(), 1e-11 * r);
+}
+
 // The solve's passes run on threads by blocks of pairs and of spheres, each
 // sphere's terms summed in the order of the serial pass over the contacts:
 // on the paper cell (thousands of active contacts, enough for the threaded

@@ -3,20 +3,25 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "mrf/fluid/kernel.hpp"
 #include "mrf/neighbors/cell_list.hpp"
 #include "coupling/dem_runs.hpp"
 
 namespace mrf {
 
+double FluidResponse::jacobian_bound(double h) { return KernelW(h)(k_jacobian_q * h); }
+
 void FluidResponse::set(std::size_t n_dem, const std::vector<CouplingPair>& pairs, const std::vector<double>& s,
-                        const std::vector<double>& rho, double mass) {
+                        const std::vector<double>& rho, double mass, double w_jacobian_min) {
   // Per DEM particle its SPH neighbours in the order of the pairs (pairs
   // come sorted by DEM index, then SPH index, so the periodic images of one
   // neighbour are adjacent: their weights add). Rebuilt every step into the
   // same buffers.
   const std::size_t na = rho.size();
   mass_ = mass;
-  start_.assign(n_dem + 1, 0);
+  std::vector<std::uint32_t>&col = exact_.by_dem.col, &start = exact_.by_dem.start;  // C's entries per DEM particle
+  std::vector<double>& weight = exact_.by_dem.w;
+  start.assign(n_dem + 1, 0);
   diag_.assign(n_dem, 0.0);
   // Blocks of DEM rows on threads, each filling its own entries (row ends
   // counted within the block, shifted when the blocks are joined in order):
@@ -26,13 +31,13 @@ void FluidResponse::set(std::size_t n_dem, const std::vector<CouplingPair>& pair
   part_scatter_.resize(static_cast<std::size_t>(blocks));
   std::vector<char> unsorted(static_cast<std::size_t>(blocks), 0);
   detail::for_blocks(n_dem, blocks, [&](std::size_t blk, std::size_t lo, std::size_t hi) {
-    // the block's own lists, handed back at the end: a push_back into a_
+    // the block's own lists, handed back at the end: a push_back into col
     // would write its header next to the members the other threads read
     // (false sharing; docs/performance.md, session 29)
     std::vector<std::uint32_t> a;
     std::vector<double> sc_of;
-    a.swap(blk == 0 ? a_ : part_a_[blk]);
-    sc_of.swap(blk == 0 ? scatter_ : part_scatter_[blk]);
+    a.swap(blk == 0 ? col : part_a_[blk]);
+    sc_of.swap(blk == 0 ? weight : part_scatter_[blk]);
     a.clear();
     sc_of.clear();
     bool unordered = false;
@@ -52,76 +57,105 @@ void FluidResponse::set(std::size_t n_dem, const std::vector<CouplingPair>& pair
           sc_of.push_back(sc);
         }
       }
-      start_[i + 1] = static_cast<std::uint32_t>(a.size());  // checked below, with the joined size
+      start[i + 1] = static_cast<std::uint32_t>(a.size());  // checked below, with the joined size
       for (std::size_t e = row; e < a.size(); ++e) diag_[i] += mass * sc_of[e] * sc_of[e];
     }
-    a.swap(blk == 0 ? a_ : part_a_[blk]);
-    sc_of.swap(blk == 0 ? scatter_ : part_scatter_[blk]);
+    a.swap(blk == 0 ? col : part_a_[blk]);
+    sc_of.swap(blk == 0 ? weight : part_scatter_[blk]);
     unsorted[blk] = unordered ? 1 : 0;
   });
   if (std::find(unsorted.begin(), unsorted.end(), 1) != unsorted.end())
     throw std::logic_error("FluidResponse::set: pairs not sorted by (i, a)");
-  std::size_t total = a_.size();
+  std::size_t total = col.size();
   for (int blk = 1; blk < blocks; ++blk) total += part_a_[static_cast<std::size_t>(blk)].size();
   checked_index(total, "fluid response");
   for (int blk = 1; blk < blocks; ++blk) {
     const auto b = static_cast<std::size_t>(blk);
-    const std::size_t offset = a_.size();
-    a_.insert(a_.end(), part_a_[b].begin(), part_a_[b].end());
-    scatter_.insert(scatter_.end(), part_scatter_[b].begin(), part_scatter_[b].end());
+    const std::size_t offset = col.size();
+    col.insert(col.end(), part_a_[b].begin(), part_a_[b].end());
+    weight.insert(weight.end(), part_scatter_[b].begin(), part_scatter_[b].end());
     for (std::size_t i = detail::block_bound(n_dem, b, static_cast<std::size_t>(blocks));
          i < detail::block_bound(n_dem, b + 1, static_cast<std::size_t>(blocks)); ++i)
-      start_[i + 1] = static_cast<std::uint32_t>(start_[i + 1] + offset);
+      start[i + 1] = static_cast<std::uint32_t>(start[i + 1] + offset);
   }
+  // C_J: the entries of C whose kernel value reaches the bound, in the same
+  // order (one pass: a small share of set(), itself a small share of a step)
+  if (w_jacobian_min > 0) {
+    if (!jacobian_) jacobian_.emplace();
+    Csr& j = jacobian_->by_dem;
+    j.start.assign(n_dem + 1, 0);
+    j.col.clear();
+    j.w.clear();
+    for (std::size_t i = 0; i < n_dem; ++i) {
+      for (std::uint32_t e = start[i]; e < start[i + 1]; ++e)
+        if (weight[e] * rho[col[e]] * s[i] >= w_jacobian_min) {
+          j.col.push_back(col[e]);
+          j.w.push_back(weight[e]);
+        }
+      j.start[i + 1] = static_cast<std::uint32_t>(j.col.size());
+    }
+    index_by_sph(*jacobian_, na, blocks);
+  } else {
+    jacobian_.reset();
+  }
+  index_by_sph(exact_, na, blocks);
+  dense_.assign(4 * na, 0.0);
+}
+
+void FluidResponse::index_by_sph(Entries& e, std::size_t na, int blocks) {
   // The same entries by SPH particle (CSR over a), so that the scatter is a
   // gather too: both passes run on threads without write conflicts, each
-  // sum in a fixed order. Built by the same blocks of DEM rows: each block
-  // counts its entries per SPH particle, the counts become each block's
-  // first free slot per SPH particle (block 0's entries first), and each
-  // block fills its own slots: every SPH particle's entries in ascending DEM
-  // order, as one pass over the rows would put them.
+  // sum in a fixed order. Built by the same blocks of DEM rows as set():
+  // each block counts its entries per SPH particle, the counts become each
+  // block's first free slot per SPH particle (block 0's entries first), and
+  // each block fills its own slots: every SPH particle's entries in
+  // ascending DEM order, as one pass over the rows would put them.
+  const Csr& d = e.by_dem;
+  Csr& r = e.by_sph;
+  const std::size_t n_dem = d.start.size() - 1;
   fill_.resize(static_cast<std::size_t>(blocks));
   detail::for_blocks(n_dem, blocks, [&](std::size_t blk, std::size_t lo, std::size_t hi) {
     std::vector<std::uint32_t>& count = fill_[blk];
     count.assign(na, 0);
-    for (std::uint32_t e = start_[lo]; e < start_[hi]; ++e) ++count[a_[e]];
+    for (std::uint32_t k = d.start[lo]; k < d.start[hi]; ++k) ++count[d.col[k]];
   });
-  rstart_.assign(na + 1, 0);
+  r.start.assign(na + 1, 0);
   for (std::size_t b = 0; b < na; ++b) {
-    std::uint32_t slot = rstart_[b];
+    std::uint32_t slot = r.start[b];
     for (std::vector<std::uint32_t>& count : fill_) {
       const std::uint32_t n = count[b];
       count[b] = slot;
       slot += n;
     }
-    rstart_[b + 1] = slot;
+    r.start[b + 1] = slot;
   }
-  rdem_.resize(a_.size());
-  rscatter_.resize(a_.size());
+  r.col.resize(d.col.size());
+  r.w.resize(d.col.size());
   detail::for_blocks(n_dem, blocks, [&](std::size_t blk, std::size_t lo, std::size_t hi) {
     std::vector<std::uint32_t>& next = fill_[blk];
     for (std::size_t i = lo; i < hi; ++i)
-      for (std::uint32_t e = start_[i]; e < start_[i + 1]; ++e) {
-        const std::uint32_t slot = next[a_[e]]++;
-        rdem_[slot] = static_cast<std::uint32_t>(i);
-        rscatter_[slot] = scatter_[e];
+      for (std::uint32_t k = d.start[i]; k < d.start[i + 1]; ++k) {
+        const std::uint32_t slot = next[d.col[k]]++;
+        r.col[slot] = static_cast<std::uint32_t>(i);
+        r.w[slot] = d.w[k];
       }
   });
   // From here on both index lists hold offsets into xyz padded to four
   // doubles (4 x index): the gathers address x[4 col] without a shift.
   checked_index(4 * std::max(na, n_dem), "fluid response offset");
-  for (std::uint32_t& b : a_) b *= 4;
-  for (std::uint32_t& j : rdem_) j *= 4;
-  dense_.assign(4 * na, 0.0);
+  for (std::uint32_t& b : e.by_dem.col) b *= 4;
+  for (std::uint32_t& j : r.col) j *= 4;
 }
 
 double FluidResponse::coupling(std::size_t i, std::size_t k) const {
+  const std::vector<std::uint32_t>&col = exact_.by_dem.col, &start = exact_.by_dem.start;  // C's entries per DEM particle
+  const std::vector<double>& weight = exact_.by_dem.w;
   // i's gather weights spread over its SPH neighbours, read back by k's
-  for (std::uint32_t p = start_[i]; p < start_[i + 1]; ++p) dense_[a_[p]] = scatter_[p];
+  for (std::uint32_t p = start[i]; p < start[i + 1]; ++p) dense_[col[p]] = weight[p];
   double c = 0;
-  for (std::uint32_t q = start_[k]; q < start_[k + 1]; ++q) c += dense_[a_[q]] * scatter_[q];
+  for (std::uint32_t q = start[k]; q < start[k + 1]; ++q) c += dense_[col[q]] * weight[q];
   c *= mass_;
-  for (std::uint32_t p = start_[i]; p < start_[i + 1]; ++p) dense_[a_[p]] = 0.0;
+  for (std::uint32_t p = start[i]; p < start[i + 1]; ++p) dense_[col[p]] = 0.0;
   return c;
 }
 
@@ -173,25 +207,37 @@ __attribute__((target_clones("avx2", "default"))) void gather4(std::size_t rows,
 
 void FluidResponse::add(const std::vector<Vec3>& f, double scale, std::vector<Vec3>& y,
                         const std::vector<std::uint32_t>* rows) {
+  product(exact_, f, scale, y, rows);
+}
+
+void FluidResponse::add_jacobian(const std::vector<Vec3>& f, double scale, std::vector<Vec3>& y,
+                                 const std::vector<std::uint32_t>* rows) {
+  product(jacobian_ ? *jacobian_ : exact_, f, scale, y, rows);
+}
+
+void FluidResponse::product(const Entries& en, const std::vector<Vec3>& f, double scale, std::vector<Vec3>& y,
+                            const std::vector<std::uint32_t>* rows) {
   // z_a = sum_j W_aj f_j / (rho_a s_j), then y_i += scale sum_a m W_ia z_a /
   // (rho_a s_i): two gathers (by SPH particle, by DEM particle), the cost of
   // a coupled contact solve (one per CG iteration). OpenMP over the outer
   // index, so each sum keeps its order.
-  const std::size_t n = f.size(), na = rstart_.size() - 1;
+  const std::size_t n = f.size(), na = en.by_sph.start.size() - 1;
   f4_.resize(4 * n);
   y4_.resize(4 * n);
   z4_.resize(4 * na);
-  const bool threads = a_.size() > k_entries_per_thread;
+  const bool threads = en.by_dem.col.size() > k_entries_per_thread;
   // the packing and unpacking on threads too: serial, they were a third of
   // the main thread's own share of a product on two threads
   const std::size_t per_thread = threads ? 1 : n + 1;
   detail::for_each_index(n, per_thread, [&](std::size_t j) {
     f4_[4 * j] = f[j].x(), f4_[4 * j + 1] = f[j].y(), f4_[4 * j + 2] = f[j].z(), f4_[4 * j + 3] = 0.0;
   });
-  gather4(na, nullptr, rstart_.data(), rdem_.data(), rscatter_.data(), f4_.data(), z4_.data(), threads);
+  gather4(na, nullptr, en.by_sph.start.data(), en.by_sph.col.data(), en.by_sph.w.data(), f4_.data(), z4_.data(),
+          threads);
   const std::size_t m = rows ? rows->size() : n;
   const std::uint32_t* row_of = rows ? rows->data() : nullptr;
-  gather4(m, row_of, start_.data(), a_.data(), scatter_.data(), z4_.data(), y4_.data(), threads);
+  gather4(m, row_of, en.by_dem.start.data(), en.by_dem.col.data(), en.by_dem.w.data(), z4_.data(), y4_.data(),
+          threads);
   const double gscale = scale * mass_;
   detail::for_each_index(m, per_thread, [&](std::size_t r) {
     const std::size_t i = row_of ? row_of[r] : r;

@@ -171,7 +171,7 @@ void ContactDual::apply(const std::vector<ContactPair>& pairs, const std::vector
       }
     });
   }
-  coupled_->add(s_, coupled_scale_, disp_, &act_particles_);
+  coupled_->add_jacobian(s_, coupled_scale_, disp_, &act_particles_);
   detail::for_blocks(m, contact_blocks, [&](std::size_t, std::size_t lo, std::size_t hi) {
     for (std::size_t a = lo; a < hi; ++a) {
       const std::uint32_t e = act_[a];

@@ -31,7 +31,7 @@ void CoupledModel::inertialess_step() {
   drift_.w0.resize(n);
   drift_.w1.resize(n);
   drift_.inv_gamma.resize(n);
-  response_.set(n, pairs_, shepard_.s, fluid_.fluid.rho, fluid_.mass);
+  response_.set(n, pairs_, shepard_.s, fluid_.fluid.rho, fluid_.mass, FluidResponse::jacobian_bound(fluid_.h));
   drift_.coupling = &response_;
   std::vector<Vec3> f_nc(n);
   for (std::size_t i = 0; i < n; ++i) {

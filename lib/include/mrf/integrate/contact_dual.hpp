@@ -18,6 +18,9 @@
 // overlap itself; here the linear part dominates (A / C ~ mob k_eff,
 // the stiffness ratio of the step) and the Hertz nonlinearity is a small
 // correction, so Newton needs few iterations from the forces of the last step.
+// The linear solves take the coupled part of M through the coupling's
+// add_jacobian (possibly a cheaper approximation), the residuals through its
+// add: the iteration converges to the same equations.
 // Open contacts are handled by projection (lambda >= 0) with an active set;
 // an update that more than doubles the largest residual is halved (down to
 // 1/8 of the Newton step), and once a solve stalls the update is made

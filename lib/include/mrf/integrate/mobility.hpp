@@ -16,6 +16,13 @@ class MobilityCoupling {
   // y_i += scale sum_j C_ij f_j, for every i or only those listed in `rows`.
   virtual void add(const std::vector<Vec3>& f, double scale, std::vector<Vec3>& y,
                    const std::vector<std::uint32_t>* rows = nullptr) = 0;
+  // The same with the operator the contact solve's Newton iterations take
+  // for their Jacobian: C, or a cheaper approximation of it (the residual
+  // is always taken with add()).
+  virtual void add_jacobian(const std::vector<Vec3>& f, double scale, std::vector<Vec3>& y,
+                            const std::vector<std::uint32_t>* rows = nullptr) {
+    add(f, scale, y, rows);
+  }
   virtual double diagonal(std::size_t i) const = 0;                 // C_ii
   virtual double coupling(std::size_t i, std::size_t k) const = 0;  // C_ik
 
