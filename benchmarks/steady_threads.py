@@ -8,7 +8,8 @@ start-up transient included. Here each model first runs a parent from the
 random start to its steady stress (paper cell, realistic path: shear rate
 1000 1/s, Mn 1e-2 set by the magnetisation; 8 strain units for model 1, 4
 for the coupled models, as in docs/performance.md session 40), kept as
-final_state.bin in out/steady_threads/parents/ (reused when present). Then
+final_state.bin in out/steady_threads/parents/ (reused when present; a
+binary of another checkpoint format refuses it: delete the folder). Then
 `mrf run --branch-from` runs a short and a long branch on 1 and on 2 threads,
 the 1- and 2-thread runs in pairs with their order alternated; the time per
 strain unit of a pair member is (long - short) / (their strain difference),

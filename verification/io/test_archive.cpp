@@ -159,7 +159,7 @@ TEST(Archive, WritesTheDocumentedLayout) {
   std::memcpy(&crc, bytes.data() + bytes.size() - 4, 4);
   EXPECT_EQ(order, 0x01020304u);
   EXPECT_EQ(version, k_archive_version);
-  EXPECT_EQ(version, 10u);
+  EXPECT_EQ(version, 11u);
   EXPECT_EQ(length, payload);
   EXPECT_EQ(crc, crc32(std::string_view(bytes).substr(0, bytes.size() - 4)));
 }

@@ -1,8 +1,10 @@
 // Branches (mrf run --branch-from): a run that starts from another run's
 // state. With the same numerics it continues the parent's trajectory row for
 // row; it may change the numerical choices (the implicit tolerance here) but
-// no physical key; its strain and warm-up count from the branch point; the
-// final state a run keeps (--keep-final-state) is a valid parent.
+// no physical key; its strain and warm-up count from the branch point, and
+// so does its summary's work (steps, list builds, Newton and CG
+// iterations); the final state a run keeps (--keep-final-state) is a valid
+// parent.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -86,6 +88,18 @@ void check_continues_parent(const std::string& path, const std::string& name) {
     EXPECT_NEAR(branch[k].strain, parent[20 + k].strain - s0, 1e-8);
   }
   EXPECT_NEAR(branch.back().strain, 0.6 - s0, 0.004);  // drive.strain from the branch point, within a step
+  // Its work is its own: the same steps as the parent's after step 40 (to
+  // within the last one), and the parent's list builds less those of its
+  // first 40 steps (at least the first build).
+  // (the coupled model's steps are DEM sub-steps, `substeps` to a step of the loop)
+  const long substeps = p.extra.count("fluid_steps") ? p.steps / static_cast<long>(p.extra.at("fluid_steps")) : 1;
+  ASSERT_GE(substeps, 1);
+  EXPECT_LE(std::abs(b.steps - (p.steps - 40 * substeps)), substeps);
+  EXPECT_GE(p.neighbor_builds - b.neighbor_builds, 1);
+  EXPECT_LE(p.neighbor_builds - b.neighbor_builds, 40);
+  if (p.extra.count("fluid_steps")) {
+    EXPECT_LE(std::abs(b.extra.at("fluid_steps") - (p.extra.at("fluid_steps") - 40)), 1.0);
+  }
 }
 
 TEST(Branch, WithTheSameNumericsContinuesTheParentRowForRow) { check_continues_parent(k_scene, "same"); }
@@ -129,7 +143,7 @@ TEST(Branch, MayChangeTheToleranceButNoPhysicalKey) {
   parent.out_dir = (base / "parent").string();
   parent.quiet = true;
   parent.keep_final_state = true;
-  run_scene(implicit_scene(0.3, {}), parent);
+  const RunSummary p = run_scene(implicit_scene(1.2, {}), parent);
   RunOptions br;
   br.quiet = true;
   br.branch_from = (base / "parent/final_state.bin").string();
@@ -137,6 +151,18 @@ TEST(Branch, MayChangeTheToleranceButNoPhysicalKey) {
   const RunSummary b = run_scene(implicit_scene(0.3, {"numerics.implicit_tol=0.0025"}), br);
   EXPECT_TRUE(std::isfinite(b.stress_total.mean));
   EXPECT_GT(b.steps, 0);
+
+  // the branch's own implicit work: at least a Newton iteration a step, and
+  // less than the longer parent's (a branch that carried its parent's
+  // counters would report more), and its mean step its own
+  br.out_dir = (base / "short").string();
+  const RunSummary sh = run_scene(implicit_scene(0.05, {"drive.warmup_strain=0.01"}), br);
+  EXPECT_GE(sh.extra.at("implicit_newton_iterations"), static_cast<double>(sh.steps));
+  EXPECT_LT(sh.extra.at("implicit_newton_iterations"), p.extra.at("implicit_newton_iterations"));
+  EXPECT_LT(sh.extra.at("implicit_linear_iterations"), p.extra.at("implicit_linear_iterations"));
+  EXPECT_LT(sh.neighbor_builds, p.neighbor_builds);
+  EXPECT_NEAR(sh.extra.at("implicit_dt_mean"), 0.05 / sh.shear_rate / static_cast<double>(sh.steps),
+              1e-6 * sh.extra.at("implicit_dt_mean"));
 
   br.out_dir = (base / "field").string();
   try {

@@ -153,7 +153,7 @@ void CoupledModel::finish(RunSummary& s) const {
   s.extra["sph_wall_layer_fraction_end"] = wall_layer_fraction(fluid_);
   s.extra["coupling_pair_builds"] = static_cast<double>(coupling_cache_.builds);
   if (implicit_) {
-    report_implicit(implicit_->counters(), time_, steps_, s);
+    report_implicit(implicit_->counters(), s);
     s.extra["fluid_steps"] = static_cast<double>(fluid_substeps_);
     s.extra["sph_pair_builds"] = static_cast<double>(sph_pairs_.builds);
     if (stepping_.sph != SphImplicit::none) s.extra["viscous_cg_iterations"] = static_cast<double>(viscous_iterations_);

@@ -110,7 +110,7 @@ StepSample DemModel::sample() const {
 }
 
 void DemModel::finish(RunSummary& s) const {
-  if (implicit_) report_implicit(implicit_->counters(), time_, steps_, s);
+  if (implicit_) report_implicit(implicit_->counters(), s);
 }
 
 void DemModel::check_finite_positions() const {

@@ -24,7 +24,13 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
   RunFiles files(opt, c);
   LoopState st;
   const RunFiles::Start start = files.open(st, frame_every > 0, [&](ArchiveReader& in) { model.load(in); });
-  if (start == RunFiles::Start::branched) st.t_origin = st.row_start = model.time();
+  if (start == RunFiles::Start::branched) {
+    st.t_origin = st.row_start = model.time();
+    RunSummary parent;  // the model's counts of work so far: the parent's, not this run's
+    model.finish(parent);
+    parent.neighbor_builds = model.lists().builds;
+    st.work_before = work_counters(parent, model.lists().ff_builds);
+  }
   // this run's strain: from its start (a branch's start is its parent's time)
   const auto run_strain = [&] { return (model.time() - st.t_origin) * c.shear_rate; };
   if (start == RunFiles::Start::resumed && !opt.quiet)
@@ -83,11 +89,14 @@ RunSummary run_scene(const LoadedScene& scene, const RunOptions& opt) {
   s.extra["seconds_per_strain"] = s.wall_seconds / c.strain;
   s.max_overlap_over_radius = st.max_overlap / c.radius;
   s.neighbor_builds = model.lists().builds;
+  // a branch counts its own work only
+  const long ff_builds = subtract_work(st.work_before, s, model.lists().ff_builds);
+  if (s.extra.count("implicit_newton_iterations"))
+    s.extra["implicit_dt_mean"] = (model.time() - st.t_origin) / static_cast<double>(std::max(1L, n));
   // The Verlet skin at the end (chosen for cost unless numerics.skin is set)
   // and the steps per free-free build (neighbors/verlet_list.hpp).
   s.extra["neighbor_skin_over_radius"] = model.lists().skin / c.radius;
-  s.extra["steps_per_pair_list_build"] =
-      static_cast<double>(n) / static_cast<double>(std::max(1L, model.lists().ff_builds));
+  s.extra["steps_per_pair_list_build"] = static_cast<double>(n) / static_cast<double>(std::max(1L, ff_builds));
   s.particle_steps_per_second = static_cast<double>(s.n_particles * s.steps) / s.wall_seconds;
   s.pair_evaluations_per_second = static_cast<double>(st.pair_evals) / s.wall_seconds;
   files.finish(s);

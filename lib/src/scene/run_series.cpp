@@ -117,14 +117,47 @@ RunSummary scene_summary(const SceneConfig& c) {
   return s;
 }
 
-void report_implicit(const ImplicitCounters& c, double time, long steps, RunSummary& s) {
+void report_implicit(const ImplicitCounters& c, RunSummary& s) {
   s.extra["implicit_rejected_steps"] = static_cast<double>(c.rejected);
   s.extra["implicit_newton_failures"] = static_cast<double>(c.newton_failures);
   s.extra["implicit_newton_iterations"] = static_cast<double>(c.newton_iterations);
   s.extra["implicit_linear_iterations"] = static_cast<double>(c.linear_iterations);
   s.extra["implicit_dt_min"] = c.dt_min;
   s.extra["implicit_dt_max"] = c.dt_max;
-  s.extra["implicit_dt_mean"] = time / static_cast<double>(std::max(1L, steps));
+}
+
+namespace {
+// The extra keys of summary.json that count work over a model's life.
+constexpr const char* k_work_keys[] = {"implicit_rejected_steps", "implicit_newton_failures",
+                                       "implicit_newton_iterations", "implicit_linear_iterations",
+                                       "fluid_steps", "sph_pair_builds", "viscous_cg_iterations",
+                                       "coupling_pair_builds", "steps_with_clamped_porosity", "sph_wall_reflections"};
+}  // namespace
+
+std::vector<double> work_counters(const RunSummary& s, long pair_list_builds) {
+  std::vector<double> w = {static_cast<double>(s.steps), static_cast<double>(s.neighbor_builds),
+                           static_cast<double>(pair_list_builds)};
+  for (const char* key : k_work_keys) {
+    const auto it = s.extra.find(key);
+    w.push_back(it == s.extra.end() ? 0.0 : it->second);
+  }
+  return w;
+}
+
+long subtract_work(const std::vector<double>& before, RunSummary& s, long pair_list_builds) {
+  if (before.empty()) return pair_list_builds;
+  if (before.size() != 3 + std::size(k_work_keys))
+    throw CheckpointError("a branch's work counters hold " + std::to_string(before.size()) + " values, this build keeps " +
+                          std::to_string(3 + std::size(k_work_keys)));
+  s.steps -= static_cast<long>(before[0]);
+  s.neighbor_builds -= static_cast<long>(before[1]);
+  std::size_t k = 3;
+  for (const char* key : k_work_keys) {
+    const auto it = s.extra.find(key);
+    if (it != s.extra.end()) it->second -= before[k];
+    ++k;
+  }
+  return pair_list_builds - static_cast<long>(before[2]);
 }
 
 void write_series_header(std::ostream& out) {

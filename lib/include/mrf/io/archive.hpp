@@ -39,10 +39,11 @@ namespace mrf {
 // removed, reordered or retyped in a save/load or serialize): the reader then
 // refuses old files by their version instead of misreading them. Version 1
 // was the headerless format before the frame existed.
-inline constexpr std::uint32_t k_archive_version = 10;  // 3: the stress series carries the cluster structure; 4: adaptive Verlet skin;
+inline constexpr std::uint32_t k_archive_version = 11;  // 3: the stress series carries the cluster structure; 4: adaptive Verlet skin;
                                                        // 5: the coupling pair cache; 6: the implicit step's carrier paths;
                                                        // 7: the quasi-static minimiser; 8: its branch point;
                                                        // 9: a run's time origin (branches); 10: its CPU seconds
+                                                       // 11: a branch's work counters at its branch point
 inline constexpr std::string_view k_archive_magic{"MRFCKPT\0", 8};
 inline constexpr std::uint32_t k_archive_byte_order = 0x01020304u;
 inline constexpr std::size_t k_archive_header_bytes = 24;  // magic, marker, version, payload length

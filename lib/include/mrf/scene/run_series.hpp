@@ -78,9 +78,19 @@ class StressSeries {
 RunSummary scene_summary(const SceneConfig& c);
 
 // The implicit scheme's work in summary.json: implicit_rejected_steps,
-// _newton_failures, _newton_iterations, _linear_iterations, _dt_min/max and
-// _dt_mean (time / steps).
-void report_implicit(const ImplicitCounters& c, double time, long steps, RunSummary& s);
+// _newton_failures, _newton_iterations, _linear_iterations and _dt_min/max
+// (the run loop adds _dt_mean, the run's time over its steps).
+void report_implicit(const ImplicitCounters& c, RunSummary& s);
+
+// The counts of work in a summary that the model keeps over its whole life
+// (steps, neighbor_builds and the extra keys of work_keys), in that order: what a
+// branch, which starts from another run's model, subtracts at its end so that
+// its summary counts its own work. The extremes (implicit_dt_min/max,
+// porosity_min/max) and momentum_drift_* stay those of the whole history.
+// `pair_list_builds`: the model's builds of its free-free pair list; returns
+// the run's own.
+std::vector<double> work_counters(const RunSummary& s, long pair_list_builds);
+long subtract_work(const std::vector<double>& before, RunSummary& s, long pair_list_builds);
 
 void write_series_header(std::ostream& out);
 void write_series_row(std::ostream& out, double time, double strain, const SeriesRow& row, double radius);
@@ -119,10 +129,13 @@ struct LoopState {
   double cpu_before = 0;      // CPU seconds (all threads) of earlier sessions of this run
   std::uint64_t ts_bytes = 0, frames_bytes = 0;  // lengths of timeseries.csv and frames.xyz
   double t_origin = 0;  // the model's time when this run began: 0, or the parent's time for a branch (s)
+  // A branch: the parent's work counters at the branch point (work_counters),
+  // which its summary subtracts; empty for a run from the start.
+  std::vector<double> work_before;
   template <class Archive, class Self>  // as StressSeries::serialize
   static void serialize(Archive& ar, Self& s) {
     ar.io(s.n, s.row_start, s.strain_before, s.se, s.max_overlap, s.pair_evals, s.elapsed_before, s.cpu_before,
-          s.ts_bytes, s.frames_bytes, s.t_origin);
+          s.ts_bytes, s.frames_bytes, s.t_origin, s.work_before);
   }
   void save(ArchiveWriter& a) const { serialize(a, *this); }
   void load(ArchiveReader& a) { serialize(a, *this); }
