@@ -19,7 +19,9 @@ void FluidResponse::set(std::size_t n_dem, const std::vector<CouplingPair>& pair
   // same buffers.
   const std::size_t na = rho.size();
   mass_ = mass;
-  std::vector<std::uint32_t>&col = exact_.by_dem.col, &start = exact_.by_dem.start;  // C's entries per DEM particle
+  // C's entries per DEM particle
+  std::vector<std::uint32_t>& col = exact_.by_dem.col;
+  std::vector<std::uint32_t>& start = exact_.by_dem.start;
   std::vector<double>& weight = exact_.by_dem.w;
   start.assign(n_dem + 1, 0);
   diag_.assign(n_dem, 0.0);
@@ -88,7 +90,7 @@ void FluidResponse::set(std::size_t n_dem, const std::vector<CouplingPair>& pair
     j.w.clear();
     for (std::size_t i = 0; i < n_dem; ++i) {
       for (std::uint32_t e = start[i]; e < start[i + 1]; ++e)
-        if (weight[e] * rho[col[e]] * s[i] >= w_jacobian_min) {
+        if (weight[e] * rho[col[e]] * s[i] >= w_jacobian_min) {  // the entry's W, over its images
           j.col.push_back(col[e]);
           j.w.push_back(weight[e]);
         }
@@ -148,7 +150,8 @@ void FluidResponse::index_by_sph(Entries& e, std::size_t na, int blocks) {
 }
 
 double FluidResponse::coupling(std::size_t i, std::size_t k) const {
-  const std::vector<std::uint32_t>&col = exact_.by_dem.col, &start = exact_.by_dem.start;  // C's entries per DEM particle
+  const std::vector<std::uint32_t>& col = exact_.by_dem.col;
+  const std::vector<std::uint32_t>& start = exact_.by_dem.start;
   const std::vector<double>& weight = exact_.by_dem.w;
   // i's gather weights spread over its SPH neighbours, read back by k's
   for (std::uint32_t p = start[i]; p < start[i + 1]; ++p) dense_[col[p]] = weight[p];

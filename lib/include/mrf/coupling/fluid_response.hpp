@@ -33,13 +33,13 @@ namespace mrf {
 
 class FluidResponse final : public MobilityCoupling {
  public:
-  // pairs sorted by DEM index, then SPH index (coupling_pairs; throws
-  // std::logic_error otherwise), the Shepard sums s_i, the
-  // density rho_a that divides the SPH sums and the SPH particle mass (kg).
   // The bound of C_J that the coupled models use: W(k_jacobian_q h) for the
   // smoothing length h (m), in 1/m^3.
   static constexpr double k_jacobian_q = 1.5;
   static double jacobian_bound(double h);
+  // pairs sorted by DEM index, then SPH index (coupling_pairs; throws
+  // std::logic_error otherwise), the Shepard sums s_i, the
+  // density rho_a that divides the SPH sums and the SPH particle mass (kg).
   // With w_jacobian_min > 0, add_jacobian leaves out the entries whose
   // kernel value (over all periodic images, 1/m^3) is below it.
   void set(std::size_t n_dem, const std::vector<CouplingPair>& pairs, const std::vector<double>& s,

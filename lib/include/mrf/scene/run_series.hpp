@@ -83,7 +83,8 @@ RunSummary scene_summary(const SceneConfig& c);
 void report_implicit(const ImplicitCounters& c, RunSummary& s);
 
 // The counts of work in a summary that the model keeps over its whole life
-// (steps, neighbor_builds and the extra keys of work_keys), in that order: what a
+// (steps, neighbor_builds and the extra keys that count iterations, failures
+// and builds; run_series.cpp lists them), in that order: what a
 // branch, which starts from another run's model, subtracts at its end so that
 // its summary counts its own work. The extremes (implicit_dt_min/max,
 // porosity_min/max) and momentum_drift_* stay those of the whole history.
