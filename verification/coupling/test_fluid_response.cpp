@@ -58,6 +58,15 @@ std::vector<Vec3> dense_product(const Coupled& u, const std::vector<Vec3>& f) {
   return y;
 }
 
+// n forces of random direction and size (N)
+std::vector<Vec3> random_forces(std::size_t n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g(0.0, 1e-9);
+  std::vector<Vec3> f(n);
+  for (auto& v : f) v = Vec3(g(rng), g(rng), g(rng));
+  return f;
+}
+
 double largest(const std::vector<Vec3>& v) {
   double m = 0;
   for (const Vec3& x : v) m = std::max(m, x.norm());
@@ -66,11 +75,7 @@ double largest(const std::vector<Vec3>& v) {
 
 TEST(FluidResponse, ProductMatchesTheDefinitionAndIsSymmetric) {
   Coupled u = make_setup(60, 3);
-  std::mt19937 rng(5);
-  std::normal_distribution<double> g(0.0, 1e-9);
-  std::vector<Vec3> f(u.dem.size()), q(u.dem.size());
-  for (auto& v : f) v = Vec3(g(rng), g(rng), g(rng));
-  for (auto& v : q) v = Vec3(g(rng), g(rng), g(rng));
+  const std::vector<Vec3> f = random_forces(u.dem.size(), 5), q = random_forces(u.dem.size(), 6);
   std::vector<Vec3> y(u.dem.size(), Vec3::Zero());
   u.response.add(f, 1.0, y);
   const std::vector<Vec3> ref = dense_product(u, f);
@@ -122,11 +127,7 @@ TEST(FluidResponse, RowsGiveTheRowsOfTheFullProduct) {
 // (1.5 / 2)^3 = 42 % of the entries.
 TEST(FluidResponse, TheJacobianOperatorLeavesOutTheKernelRim) {
   Coupled u = make_setup(60, 3);
-  std::mt19937 rng(7);
-  std::normal_distribution<double> g(0.0, 1e-9);
-  std::vector<Vec3> f(u.dem.size()), q(u.dem.size());
-  for (auto& v : f) v = Vec3(g(rng), g(rng), g(rng));
-  for (auto& v : q) v = Vec3(g(rng), g(rng), g(rng));
+  const std::vector<Vec3> f = random_forces(u.dem.size(), 7), q = random_forces(u.dem.size(), 8);
   std::vector<Vec3> y(u.dem.size(), Vec3::Zero()), yj(u.dem.size(), Vec3::Zero());
   u.response.add(f, 1.0, y);
   u.response.add_jacobian(f, 1.0, yj);

@@ -181,39 +181,55 @@ class UniformCoupling final : public MobilityCoupling {
   double c_;
 };
 
-// One sphere pressed between two walls, in a fluid whose response to the
-// walls' unbalanced push is 50x the drag's mobility. Both wall contacts act
-// on the same sphere, so s C enters their off-diagonal entry; IC(0) with it
-// is the exact factor and each Newton solve needs one CG iteration (with
-// the coupling on the diagonal only, as before, it needs two). The forces
-// that come out balance the step's equation and the Hertz law.
-TEST(ContactDual, CoupledWallContactsOfOneSphereFactorExactly) {
-  const double r = 1e-6, k = 1e4, mob = 1e-3, c = 5e4, s = 1e-6;  // s c = 50 mob
-  const Box box{10 * r, 10 * r, 10 * r};
+// One sphere pressed between two walls by b, in a fluid whose response to
+// the walls' unbalanced push is 50x the drag's mobility (s c = 50 mob), each
+// Newton solve converged to 1e-12 R.
+struct SphereBetweenWalls {
+  double r = 1e-6, k = 1e4, mob = 1e-3, c = 5e4, s = 1e-6;
+  Box box{10 * r, 10 * r, 10 * r};
   WallParticles walls;
-  walls.x = {Vec3(-1.99 * r, 0, 0), Vec3(1.995 * r, 0, 0)};
-  walls.side = {-1, 1};
-  const std::vector<ContactPair> pairs = {{0, 0, true}, {0, 1, true}};
-  const std::vector<Vec3> x0 = {Vec3::Zero()}, b = {Vec3(2e-3 * r, 0, 0)};
-  UniformCoupling fluid(c);
+  std::vector<ContactPair> pairs = {{0, 0, true}, {0, 1, true}};
+  std::vector<Vec3> x0 = {Vec3::Zero()}, b = {Vec3(2e-3 * r, 0, 0)};
+  SphereBetweenWalls() {
+    walls.x = {Vec3(-1.99 * r, 0, 0), Vec3(1.995 * r, 0, 0)};
+    walls.side = {-1, 1};
+  }
+  // y and the force on the sphere
+  NewtonResult solve(ContactDual& dual, MobilityCoupling& fluid, std::vector<Vec3>& y, Vec3& f) const {
+    NewtonOptions opt;
+    opt.tol = 1e-12 * r;
+    opt.max_iterations = 50;
+    opt.linear_rtol = 1e-12;
+    const NewtonResult res = dual.solve(pairs, b, x0, walls, walls, box, r, k, {mob}, &fluid, s, opt, y);
+    std::vector<Vec3> forces(1, Vec3::Zero());
+    dual.add_forces(pairs, forces);
+    f = forces[0];
+    return res;
+  }
+};
+
+// Both wall contacts act on the same sphere, so s C enters their
+// off-diagonal entry; IC(0) with it is the exact factor and each Newton
+// solve needs one CG iteration (with the coupling on the diagonal only, as
+// before, it needs two). The forces that come out balance the step's
+// equation and the Hertz law.
+TEST(ContactDual, CoupledWallContactsOfOneSphereFactorExactly) {
+  const SphereBetweenWalls sw;
+  UniformCoupling fluid(sw.c);
   ContactDual dual;
   dual.set_preconditioner(ContactDual::Preconditioner::incomplete_cholesky);
-  NewtonOptions opt;
-  opt.tol = 1e-12 * r;
-  opt.max_iterations = 50;
-  opt.linear_rtol = 1e-12;
   std::vector<Vec3> y;
-  const NewtonResult res = dual.solve(pairs, b, x0, walls, walls, box, r, k, {mob}, &fluid, s, opt, y);
+  Vec3 f;
+  const NewtonResult res = sw.solve(dual, fluid, y, f);
   ASSERT_TRUE(res.converged) << "last correction " << res.last_correction;
   EXPECT_LE(res.linear_iterations, res.iterations - 1) << "one CG iteration per Newton solve";
-  std::vector<Vec3> f(1, Vec3::Zero());
-  dual.add_forces(pairs, f);
   // y = b + (mob + s c) f, and each force is the Hertz force of its overlap
-  EXPECT_NEAR(y[0].x(), b[0].x() + (mob + s * c) * f[0].x(), 1e-9 * r);
-  const double left = 2 * r - (y[0].x() - walls.x[0].x()), right = 2 * r - (walls.x[1].x() - y[0].x());
+  const double r = sw.r, k = sw.k;
+  EXPECT_NEAR(y[0].x(), sw.b[0].x() + (sw.mob + sw.s * sw.c) * f.x(), 1e-9 * r);
+  const double left = 2 * r - (y[0].x() - sw.walls.x[0].x()), right = 2 * r - (sw.walls.x[1].x() - y[0].x());
   EXPECT_GT(left, 0.0);
   EXPECT_GT(right, 0.0);
-  EXPECT_NEAR(f[0].x(), k * std::pow(left, 1.5) - k * std::pow(right, 1.5), 1e-9 * k * std::pow(left, 1.5));
+  EXPECT_NEAR(f.x(), k * std::pow(left, 1.5) - k * std::pow(right, 1.5), 1e-9 * k * std::pow(left, 1.5));
 }
 
 // A coupling whose Jacobian is a cruder C (c_J = 0.6 c): the Newton
@@ -243,33 +259,22 @@ class CrudeJacobianCoupling final : public MobilityCoupling {
 };
 
 TEST(ContactDual, AnApproximateJacobianConvergesToTheSameForces) {
-  const double r = 1e-6, k = 1e4, mob = 1e-3, c = 5e4, s = 1e-6;
-  const Box box{10 * r, 10 * r, 10 * r};
-  WallParticles walls;
-  walls.x = {Vec3(-1.99 * r, 0, 0), Vec3(1.995 * r, 0, 0)};
-  walls.side = {-1, 1};
-  const std::vector<ContactPair> pairs = {{0, 0, true}, {0, 1, true}};
-  const std::vector<Vec3> x0 = {Vec3::Zero()}, b = {Vec3(2e-3 * r, 0, 0)};
-  NewtonOptions opt;
-  opt.tol = 1e-12 * r;
-  opt.max_iterations = 50;
-  opt.linear_rtol = 1e-12;
-  UniformCoupling exact(c);
-  CrudeJacobianCoupling crude(c);
-  std::vector<Vec3> y_exact, y_crude, f_exact(1, Vec3::Zero()), f_crude(1, Vec3::Zero());
+  const SphereBetweenWalls sw;
+  UniformCoupling exact(sw.c);
+  CrudeJacobianCoupling crude(sw.c);
+  std::vector<Vec3> y_exact, y_crude;
+  Vec3 f_exact, f_crude;
   ContactDual a, d;
-  const NewtonResult ra = a.solve(pairs, b, x0, walls, walls, box, r, k, {mob}, &exact, s, opt, y_exact);
-  const NewtonResult rd = d.solve(pairs, b, x0, walls, walls, box, r, k, {mob}, &crude, s, opt, y_crude);
+  const NewtonResult ra = sw.solve(a, exact, y_exact, f_exact);
+  const NewtonResult rd = sw.solve(d, crude, y_crude, f_crude);
   ASSERT_TRUE(ra.converged);
   ASSERT_TRUE(rd.converged) << "last correction " << rd.last_correction;
-  a.add_forces(pairs, f_exact);
-  d.add_forces(pairs, f_crude);
   EXPECT_GT(crude.jacobian_adds, 0) << "the linear solves apply C_J";
   EXPECT_GT(crude.adds, 0) << "the residuals apply C";
   EXPECT_GT(rd.iterations, ra.iterations) << "a cruder Jacobian converges more slowly";
-  EXPECT_NEAR(y_crude[0].x(), b[0].x() + (mob + s * c) * f_crude[0].x(), 1e-9 * r);
-  EXPECT_NEAR(f_crude[0].x(), f_exact[0].x(), 1e-6 * std::abs(f_exact[0].x()));  // both to 1e-12 R in overlap
-  EXPECT_NEAR(y_crude[0].x(), y_exact[0].x(), 1e-11 * r);
+  EXPECT_NEAR(y_crude[0].x(), sw.b[0].x() + (sw.mob + sw.s * sw.c) * f_crude.x(), 1e-9 * sw.r);
+  EXPECT_NEAR(f_crude.x(), f_exact.x(), 1e-6 * std::abs(f_exact.x()));  // both to 1e-12 R in overlap
+  EXPECT_NEAR(y_crude[0].x(), y_exact[0].x(), 1e-11 * sw.r);
 }
 
 // The solve's passes run on threads by blocks of pairs and of spheres, each
