@@ -81,7 +81,9 @@ void FluidResponse::set(std::size_t n_dem, const std::vector<CouplingPair>& pair
       start[i + 1] = static_cast<std::uint32_t>(start[i + 1] + offset);
   }
   // C_J: the entries of C whose kernel value reaches the bound, in the same
-  // order (one pass: a small share of set(), itself a small share of a step)
+  // order (one pass: a small share of set(), itself a small share of a step).
+  // It reads col as SPH indices: before index_by_sph(exact_) turns them into
+  // offsets.
   if (w_jacobian_min > 0) {
     if (!jacobian_) jacobian_.emplace();
     Csr& j = jacobian_->by_dem;
