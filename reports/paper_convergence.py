@@ -15,7 +15,20 @@ scatter / sqrt(n)). The shift is
 quoted in per cent of the base and in combined standard errors. A variant
 whose own run is not steady (drift |z| >= 3 or MSER-5 discard >= 0.2) is
 marked: its shift is then not yet a measurement.
+
+Beside it, a reading (not the table's rule): the shift in combined standard
+errors with the seed standard deviation pooled over every seed set of the
+same model and Mn that the repository holds, the base and the implicit-
+tolerance ladders (reports/study/paper/tolerance*/points, one set per
+tolerance), sqrt(sum (n_k - 1) s_k^2 / sum (n_k - 1)), in the place of the
+base's own. A set of three seeds (2 degrees of freedom) can give a seed SD
+far too small; the pooled one rests on more. The ladders' sets share their
+seeds' starting states with each other (and the coupled ladder with the
+base), so their degrees of freedom, which the column quotes, are an upper
+bound.
 """
+import glob
+import json
 import csv
 import math
 import os
@@ -38,17 +51,48 @@ def f(r, k):
         return float("nan")
 
 
-def shift(r, base):
+def seed_sets(paper_dir):
+    """(model, Mn) -> [(seed, stress_total in Pa, magnetization), ...] per
+    seed set of the tolerance ladders: one set per archive and tolerance."""
+    sets = defaultdict(list)
+    for ladder in sorted(glob.glob(os.path.join(paper_dir, "tolerance*", "points"))):
+        for tol in sorted(glob.glob(os.path.join(ladder, "*", "tol_*"))):
+            by_mn = defaultdict(list)
+            for path in sorted(glob.glob(os.path.join(tol, "mn_*_seed_*", "summary.json"))):
+                with open(path) as fh:
+                    sm = json.load(fh)
+                mn = float(os.path.basename(os.path.dirname(path)).split("_")[1])
+                by_mn[mn].append((sm["stress_total"], sm["magnetization"]))
+            for mn, got in by_mn.items():
+                sets[(os.path.basename(os.path.dirname(tol)), mn)].append(got)
+    return sets
+
+
+def pooled_sd(groups):
+    """Pooled standard deviation and its degrees of freedom over groups of
+    values (each group of at least 2)."""
+    groups = [g for g in groups if len(g) > 1]
+    dof = sum(len(g) - 1 for g in groups)
+    if not dof:
+        return float("nan"), 0
+    return math.sqrt(sum((len(g) - 1) * statistics.variance(g) for g in groups) / dof), dof
+
+
+def shift(r, base, sd_in=None):
     """A one-seed variant row r against its base's seed rows (same model and
     Mn), in units of the base's scale: (variant, its error, base mean, base
     error, sigma). Variant error: max(within-run, the base's seed SD); base
-    error: max(the largest within-run error of its seeds, SD / sqrt(n))."""
+    error: max(the largest within-run error of its seeds, SD / sqrt(n)).
+    sd_in: a seed SD (in the base's scale) to use in the place of the
+    base's own."""
     phi = f(r, "volume_fraction")
     sc = (phi if phi == phi else 0.30) * MU0 * f(r, "magnetization") ** 2
     t, e = f(r, "stress_total") / sc, f(r, "stress_total_err") / sc
     bt = [f(x, "stress_total") / sc for x in base]
     within = max(f(x, "stress_total_err") for x in base) / sc
     sd = statistics.stdev(bt) if len(bt) > 1 else 0.0
+    if sd_in is not None:
+        sd = sd_in
     bm, be = statistics.mean(bt), max(within, sd / math.sqrt(len(bt)))
     ve = max(e, sd)
     return t, ve, bm, be, (t - bm) / math.hypot(be, ve)
@@ -93,6 +137,18 @@ def main(argv):
     base = defaultdict(list)
     for r in base_rows:
         base[(r["model"], float(r["mason"]))].append(r)
+    # the pooled seed SD per (model, Mn), in phi mu0 M^2: the base's seeds
+    # and every tolerance ladder's set of the same point
+    ladders = seed_sets(os.path.dirname(os.path.abspath(out)))
+    pooled = {}
+    for key, b in base.items():
+        phi = f(b[0], "volume_fraction")
+        phi = phi if phi == phi else 0.30
+        groups = [[f(x, "stress_total") / (phi * MU0 * f(x, "magnetization") ** 2) for x in b]]
+        groups += [[v / (phi * MU0 * m ** 2) for v, m in g] for g in ladders.get(key, [])]
+        sd, dof = pooled_sd(groups)
+        base_sd, base_dof = pooled_sd(groups[:1])
+        pooled[key] = (sd, dof, len(groups) - 1, base_sd, base_dof)
     lines = ["# Convergence of the paper-scale stress (issue 13)", "",
              "experiments/sweeps/paper_convergence.toml: one numerical choice changed per variant, one seed, on the "
              "realistic path (1000 1/s, M from Mn) and the base's strain rules; written by reports/paper_convergence.py. "
@@ -103,9 +159,11 @@ def main(argv):
              "combined standard errors. Where the base's seed scatter rests on 3 seeds (2 degrees of freedom) it can "
              "be far too small: model 3 at Mn 1 (the report's state note). Model 2 shares model 3's numerics (SPH, "
              "coupling, implicit contacts) and differs in the drag law only: it runs the two choices that move model "
-             "3 most (gap, SPH spacing) and the carrier, and inherits model 3's rows for the others.", "",
-             "| model | Mn | variant | wall stress | base (seeds) | shift | shift / sigma | particle part shift | "
-             "variant steady | s per strain |", "|---|---:|---|---:|---:|---:|---:|---:|---|---:|"]
+             "3 most (gap, SPH spacing) and the carrier, and inherits model 3's rows for the others. Column "
+             "'pooled': a reading, not the rule: the same shift with the seed SD pooled over the base and the "
+             "implicit-tolerance ladders' seed sets of the same point (the table below it).", "",
+             "| model | Mn | variant | wall stress | base (seeds) | shift | shift / sigma | pooled | particle part shift | "
+             "variant steady | s per strain |", "|---|---:|---|---:|---:|---:|---:|---:|---:|---|---:|"]
     lever = {}  # (model, Mn) -> (|shift|, variant, shift, sigma, steady): the largest mover
     bars = []  # (model, Mn), variant, shift %, its combined error %, steady: the figure
     shifts = {}  # (model, Mn, variant) -> shift of the total and of the particle part (%)
@@ -118,10 +176,11 @@ def main(argv):
         steady = abs(f(r, "stress_total_drift_z")) < DRIFT_Z and f(r, "steady_mser_discard_fraction") < MSER_MAX
         per = f(r, "wall_seconds") / f(r, "strain")
         if not b:
-            lines.append(f"| {r['model']} | {key[1]:g} | {r['variant']} | {t:.5f} ± {e:.5f} | – | – | – | – | "
+            lines.append(f"| {r['model']} | {key[1]:g} | {r['variant']} | {t:.5f} ± {e:.5f} | – | – | – | – | – | "
                          f"{'yes' if steady else '**no**'} | {per:.3g} |")
             continue
         _, ve, bm, be, z = shift(r, b)
+        zp = shift(r, b, pooled[key][0])[4] if pooled[key][1] else float("nan")
         pm = statistics.mean([(f(x, "stress_total") - f(x, "stress_fluid")) / sc for x in b])
         vp = (f(r, "stress_total") - f(r, "stress_fluid")) / sc
         bars.append((key, r["variant"], 100 * (t / bm - 1), 100 * math.hypot(ve, be * t / bm) / bm, steady))
@@ -132,8 +191,19 @@ def main(argv):
         if steady and valid and abs(z) > lever.get(key, (-1,))[0]:
             lever[key] = (abs(z), r["variant"], t / bm - 1, z, steady)
         lines.append(f"| {r['model']} | {key[1]:g} | {r['variant']} | {t:.5f} ± {ve:.5f} | {bm:.5f} ± {be:.5f} "
-                     f"({len(b)}) | {100 * (t / bm - 1):+.1f} % | {z:+.1f} | {100 * (vp / pm - 1):+.1f} % | "
+                     f"({len(b)}) | {100 * (t / bm - 1):+.1f} % | {z:+.1f} | {zp:+.1f} | {100 * (vp / pm - 1):+.1f} % | "
                      f"{'yes' if steady else '**no**'} | {per:.3g} |")
+    conv_keys = sorted({(r["model"], float(r["mason"])) for r in conv if (r["model"], float(r["mason"])) in pooled})
+    if conv_keys:
+        lines += ["", "The seed SD of each point (phi mu0 M^2): the base's own against the one pooled with the "
+                  "tolerance ladders' sets (column 'pooled' above; degrees of freedom in brackets, an upper bound "
+                  "where sets share their seeds' starting states):", "",
+                  "| model | Mn | base seed SD (dof) | ladder sets | pooled seed SD (dof) | pooled / base |",
+                  "|---|---:|---:|---:|---:|---:|"]
+        for key in conv_keys:
+            sd, dof, nsets, bsd, bdof = pooled[key]
+            lines.append(f"| {key[0]} | {key[1]:g} | {bsd:.2e} ({bdof}) | {nsets} | {sd:.2e} ({dof}) | "
+                         f"{sd / bsd if bsd > 0 else float('nan'):.2f} |")
     if lever:
         lines += ["", "The largest lever per model and Mn: the variant whose shift is largest in combined standard "
                   "errors, among those that are measurements (steady, and an SPH spacing the coupling admits):", ""]
