@@ -129,6 +129,55 @@ def open_mn_failures(root, work):
     return out
 
 
+def pooled_failures(root, work, py):
+    """reports/paper_convergence.py's 'pooled' reading on a point whose
+    answer is known: model 3 at Mn 1, a base of three seeds (1.00, 1.01,
+    1.02 phi mu0 M^2: SD 0.01 on 2 dof) and two tolerance-ladder sets
+    (0.9, 1.0, 1.1: SD 0.1 on 2 dof; 1.0, 1.0: 0 on 1 dof), so the pooled
+    SD is sqrt((2e-4 + 2e-2) / 5) = 0.06356 on 5 dof. One variant at 1.10
+    with a tiny within-run error: by the rule's SD its shift is
+    0.09 / hypot(0.01 / sqrt 3, 0.01) = +7.8 standard errors, by the
+    pooled one 0.09 / hypot(0.06356 / sqrt 3, 0.06356) = +1.2."""
+    paper = os.path.join(work, "pooled")
+    shutil.rmtree(paper, ignore_errors=True)
+    m = math.sqrt(9 * ETA * GDOT / (2 * MU0 * 1.0))
+    sc = PHI * MU0 * m * m
+    cols = ["model", "mason", "seed", "variant", "status", "stress_total", "stress_total_err", "magnetization",
+            "volume_fraction", "stress_total_drift_z", "steady_mser_discard_fraction", "wall_seconds", "strain"]
+
+    def table(name, runs):
+        path = os.path.join(paper, name)
+        with open(path, "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(cols)
+            for seed, variant, t in runs:
+                w.writerow(["demsph_dd", 1.0, seed, variant, "ok", repr(t * sc), repr(1e-5 * sc), repr(m), PHI, 0.1,
+                            0.0, 100.0, 60])
+        return path
+
+    for tol, values in (("tol_0.01", (0.9, 1.0, 1.1)), ("tol_0.0025", (1.0, 1.0))):
+        for seed, t in enumerate(values, 1):
+            d = os.path.join(paper, "tolerance_coupled", "points", "demsph_dd", tol, f"mn_1_seed_{seed}")
+            os.makedirs(d)
+            with open(os.path.join(d, "summary.json"), "w") as fh:
+                json.dump({"stress_total": t * sc, "magnetization": m}, fh)
+    base = table("base.csv", [(1, "", 1.00), (2, "", 1.01), (3, "", 1.02)])
+    conv = table("conv.csv", [(1, "gap_300", 1.10)])
+    out = os.path.join(paper, "convergence.md")
+    subprocess.run([py, os.path.join(root, "reports", "paper_convergence.py"), conv, base, out], check=True,
+                   stdout=subprocess.DEVNULL)
+    md = open(out).read()
+    fails = []
+    row = [x for x in md.splitlines() if x.startswith("| demsph_dd | 1 | gap_300 |")]
+    cells = [x.strip() for x in row[0].strip("|").split("|")] if len(row) == 1 else []
+    if not cells or cells[6] != "+7.8" or cells[7] != "+1.2":
+        fails.append(f"pooled seed SD: the variant's row {row}, want +7.8 by the rule and +1.2 pooled")
+    sd_row = [x for x in md.splitlines() if x.startswith("| demsph_dd | 1 | 1.00e-02 (2) |")]
+    if len(sd_row) != 1 or "| 2 | 6.36e-02 (5) | 6.36 |" not in sd_row[0]:
+        fails.append(f"pooled seed SD: the SD table's row {sd_row}, want base 1.00e-02 (2), 2 sets, 6.36e-02 (5)")
+    return fails
+
+
 def main(argv):
     mrf, root, work = argv[1], argv[2], argv[3]
     shutil.rmtree(work, ignore_errors=True)
@@ -350,6 +399,7 @@ def main(argv):
             check(f"one-window bin {cells[col]} at strain {mid}", float(cells[col]),
                   tau1 + ONE_WINDOW_SLOPE * (mid - 32), 0.6)
         check("one-window second half, in its error", float(cells[9]), ONE_WINDOW_SLOPE * 8.05 / (0.005 * tau1), 0.06)
+    failures += pooled_failures(root, work, py)
     # (in the interpreter that has matplotlib, which paper_rules imports through study.py)
     res = subprocess.run([py, os.path.abspath(__file__), "--open-mn", root, work], capture_output=True, text=True)
     failures += [x for x in res.stdout.splitlines() if x.startswith("open Mn 1e-3 rule")]
