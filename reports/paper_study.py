@@ -323,39 +323,53 @@ def sweep_cost(rows, firsts, beside=()):
             + (f", {len(beside)} beside" if beside else "") + ")." + cpu, ""]
 
 
-def main(argv):
-    if len(argv) < 3:
-        print(__doc__)
-        return 2
-    sweep_dir, out = argv[1], argv[2]
-    here = os.path.dirname(os.path.abspath(__file__))
-    small_path = arg(argv, "--small", os.path.join(here, "study", "flow_curves.csv"))
-    os.makedirs(out, exist_ok=True)
-    rows = [r for r in read_rows(os.path.join(sweep_dir, "sweep.csv")) if r["status"] == "ok"]
-    # the coupled runs at Mn 1e-3 under both carriers (scripts/paper_interim.py's carrier_swap)
-    carrier_path = arg(argv, "--carrier", os.path.join(here, "study", "paper", "low_carrier.csv"))
-    carrier = [r for r in read_rows(carrier_path) if r["status"] == "ok"] if os.path.exists(carrier_path) else []
-    crit = json.load(open(os.path.join(sweep_dir, "criterion.json")))
-    phi = crit["volume_fraction"]
-    models = [k for k in ORDER if k in crit["models"]]
-    expt = experiment_points(os.path.join(here, "..", "experiments", "data", "experiment_mrf.csv"))
-    small = defaultdict(dict)
-    if os.path.exists(small_path):
-        for r in read_rows(small_path):
-            small[r["model"]][float(r["mason"])] = (num(r, "stress_Pa"), num(r, "err_Pa"))
-    qs_path = arg(argv, "--quasistatic", os.path.join(here, "quasistatic", "paper", "results.csv"))
-    qs = list(read_rows(qs_path)) if os.path.exists(qs_path) else []
-    # The AQS value to quote: the mean of the seed realisations over their
-    # common window, its error the standard error of their scatter
-    # (reports/quasistatic/README.md §5); --aqs-seeds names the runs.
-    seed_runs = arg(argv, "--aqs-seeds", "headline_0.45,seed2,seed3").split(",")
-    seed_vals = [num(r, "stress_over_phi_mu0_m2") for r in qs if r["run"] in seed_runs]
-    aqs_quote = ((statistics.mean(seed_vals), statistics.stdev(seed_vals) / math.sqrt(len(seed_vals)), len(seed_vals))
-                 if len(seed_vals) >= 2 else (float("nan"), float("nan"), len(seed_vals)))
-    small_m = 1e6  # the small-cell study's fixed magnetisation (experiments/sweeps/default.toml)
-    gdot = num(rows[0], "shear_rate") if rows else float("nan")
+class Study:
+    """What every section of the report reads: the runs, mrf criterion's
+    points, the small cell, the quasi-static values and the command line."""
 
-    # ---- stress against Mn: total and particle part -------------------------
+    def __init__(self, argv):
+        self.argv = argv
+        self.sweep_dir, self.out = argv[1], argv[2]
+        self.here = here = os.path.dirname(os.path.abspath(__file__))
+        self.rows = [r for r in read_rows(os.path.join(self.sweep_dir, "sweep.csv")) if r["status"] == "ok"]
+        # the coupled runs at Mn 1e-3 under both carriers (scripts/paper_interim.py's carrier_swap)
+        carrier_path = arg(argv, "--carrier", os.path.join(here, "study", "paper", "low_carrier.csv"))
+        self.carrier = ([r for r in read_rows(carrier_path) if r["status"] == "ok"]
+                        if os.path.exists(carrier_path) else [])
+        self.crit = json.load(open(os.path.join(self.sweep_dir, "criterion.json")))
+        self.phi = self.crit["volume_fraction"]
+        self.models = [k for k in ORDER if k in self.crit["models"]]
+        self.expt = experiment_points(os.path.join(here, "..", "experiments", "data", "experiment_mrf.csv"))
+        self.small = defaultdict(dict)
+        small_path = arg(argv, "--small", os.path.join(here, "study", "flow_curves.csv"))
+        if os.path.exists(small_path):
+            for r in read_rows(small_path):
+                self.small[r["model"]][float(r["mason"])] = (num(r, "stress_Pa"), num(r, "err_Pa"))
+        qs_path = arg(argv, "--quasistatic", os.path.join(here, "quasistatic", "paper", "results.csv"))
+        self.qs = list(read_rows(qs_path)) if os.path.exists(qs_path) else []
+        # The AQS value to quote: the mean of the seed realisations over their
+        # common window, its error the standard error of their scatter
+        # (reports/quasistatic/README.md §5); --aqs-seeds names the runs.
+        self.seed_runs = arg(argv, "--aqs-seeds", "headline_0.45,seed2,seed3").split(",")
+        seed_vals = [num(r, "stress_over_phi_mu0_m2") for r in self.qs if r["run"] in self.seed_runs]
+        self.aqs_quote = ((statistics.mean(seed_vals), statistics.stdev(seed_vals) / math.sqrt(len(seed_vals)),
+                           len(seed_vals)) if len(seed_vals) >= 2 else (float("nan"), float("nan"), len(seed_vals)))
+        self.small_m = 1e6  # the small-cell study's fixed magnetisation (experiments/sweeps/default.toml)
+        self.gdot = num(self.rows[0], "shear_rate") if self.rows else float("nan")
+        self.grid = [1e-3, 1e-2, 0.1, 1.0, 10.0]
+        self.low_rows = low_mn_rows(argv, here)  # model 1 below Mn 1e-3
+        self.by = defaultdict(list)  # (model, Mn) -> its runs
+        for r in self.rows:
+            self.by[(r["model"], float(r["mason"]))].append(r)
+
+
+def stress_figure(st):
+    """stress_vs_mason: the total and the particle part against Mn, the small
+    cell, model 1 below Mn 1e-3, the quasi-static value, theory and
+    experiment."""
+    crit, phi, small, small_m, low_rows, qs, aqs_quote = st.crit, st.phi, st.small, st.small_m, st.low_rows, st.qs, \
+        st.aqs_quote
+    models, expt, gdot, out = st.models, st.expt, st.gdot, st.out
     fig, axs = plt.subplots(1, 2, figsize=(13, 5))
     for k in models:
         p = crit["models"][k]["points"]
@@ -371,7 +385,6 @@ def main(argv):
             axs[0].errorbar(xs, [small[k][m][0] / (phi * MU0 * small_m ** 2) for m in xs],
                             yerr=[small[k][m][1] / (phi * MU0 * small_m ** 2) for m in xs], fmt="x:", ms=4,
                             capsize=2, color=COLOR[k], alpha=0.6, label=LABEL[k] + " (small cell, fixed M)")
-    low_rows = low_mn_rows(argv, here)
     if low_rows:  # model 1 below Mn 1e-3 (its section)
         for ax, particle_part in ((axs[0], False), (axs[1], True)):
             mean, err, _, _ = seed_combined(low_rows, phi, particle_part)
@@ -402,7 +415,11 @@ def main(argv):
              fontsize=7)
     save(fig, out, "stress_vs_mason")
 
-    # ---- tables ---------------------------------------------------------------
+
+def opening_tables(st):
+    """The title, the state note, the progress table and the stress per point."""
+    rows, crit, phi, models, small, small_m, gdot, grid, argv = st.rows, st.crit, st.phi, st.models, st.small, \
+        st.small_m, st.gdot, st.grid, st.argv
     lines = ["# The paper-scale study (issue 13)", "",
              f"Paper cell (150 x 50 x 120 um, {int(num(rows[0], 'n_particles')) if rows else 0} spheres, dipole "
              f"cut-off 4 d, Y = 200 GPa) on the realistic path: gdot = {gdot:g} 1/s for every point, "
@@ -411,7 +428,6 @@ def main(argv):
     if "--note" in argv:
         lines += [arg(argv, "--note", ""), ""]
     lines += ["![stress](stress_vs_mason.png)", ""]
-    grid = [1e-3, 1e-2, 0.1, 1.0, 10.0]
     done = defaultdict(int)
     for r in rows:
         done[(r["model"], float(r["mason"]))] += 1
@@ -445,8 +461,15 @@ def main(argv):
             lines.append(f"| {k} | {q['mason']:g} | {q['seeds']} | {t:.4f} ± {ef} | "
                          f"{(q['stress'] - q['stress_fluid']) / s:.4f} ± {ef}{particle_note(pstate.get((k, mkey(q['mason']))))} | "
                          f"{rf} | {cmp_} |")
+    return lines
+
+
+def steadiness(st):
+    """The steadiness of every run, the post-hoc readings and the earlier
+    runs of points re-run for steadiness; returns the lines and those runs."""
+    rows, argv, here = st.rows, st.argv, st.here
     newer = sum(1 for r in rows if num(r, "error_estimate_version") >= 2)
-    lines += ["", f"## Steadiness of every run (drift |z| < {DRIFT_Z:g} and MSER-5 discard < {MSER_MAX:g})", "",
+    lines = ["", f"## Steadiness of every run (drift |z| < {DRIFT_Z:g} and MSER-5 discard < {MSER_MAX:g})", "",
               f"Error estimate: {newer} of {len(rows)} runs carry the block error widened by the blocks' residual "
               "correlation, with the drift test on detrended halves (`error_estimate_version` 2, from session 24); "
               "the others the plain Jonsson level, whose errors are too small and whose drift test flags too often "
@@ -522,12 +545,13 @@ def main(argv):
                          f"{f['strain']:g} ({f['warmup_strain']:g}) | "
                          f"{f['stress_total_drift_z']:+.2f} | {f['steady_mser_discard_fraction']:.3f} | "
                          f"{'yes' if ok else '**no**'} | {state} |")
-    # the one-window rule's runs are the per-particle ones, in the headline or beside it (the carrier section)
-    pp_low = [r for r in carrier if r["carrier"] == "per_particle"] or rows
-    lines += one_window(pp_low, firsts, phi, arg(argv, "--points", os.path.join(here, "study", "paper", "points")))
-    lines += carrier_section(carrier, arg(argv, "--common-points", os.path.join(here, "study", "paper", "common_low",
-                                                                                  "points")))
-    lines += ["", "Cost: wall seconds per strain unit of each run, one thread, on a shared 2-core machine "
+    return lines, firsts
+
+
+def cost_section(st, firsts):
+    """The whole sweep's wall time and the cost per strain unit per model and Mn."""
+    rows, carrier, models, grid = st.rows, st.carrier, st.models, st.grid
+    lines = ["", "Cost: wall seconds per strain unit of each run, one thread, on a shared 2-core machine "
               "(the sweep ran at nice 19 beside other work: an upper bound, not a benchmark; "
               "reports/performance/model_ratios.md has the side-by-side ratios).", ""]
     lines += sweep_cost(rows, firsts, [r for r in carrier if r["in_headline"] == "no"])
@@ -549,8 +573,13 @@ def main(argv):
             cells.append("–" if v != v else f"{v:.3g}" + ("" if k == "dem_stokes" or v1 != v1 else f" ({v / v1:.1f}x)"))
         lines.append(f"| {k} | " + " | ".join(cells) + " |")
     lines.append("")
-    # ---- wall against volume stress: what the imposed flow of model 1 absorbs --
-    lines += ["## Wall and volume-side stress per model", "",
+    return lines
+
+
+def wall_volume(st):
+    """Wall against volume-side stress: what model 1's imposed flow absorbs."""
+    phi, models, grid, by = st.phi, st.models, st.grid, st.by
+    lines = ["## Wall and volume-side stress per model", "",
               "Seed means over φμ0M²; volume side = the particle pair virial plus the carrier's part (model 1: "
               "eta gdot; models 2 and 3: the SPH virial and the exchange virial). m = 1 - wall/volume is the "
               "share of the particle stress that model 1's imposed flow absorbs instead of returning to the "
@@ -558,9 +587,6 @@ def main(argv):
               "against the wall stress of demsph_dd at the same Mn.", "",
               "| model | Mn | seeds | wall | volume side | m | volume / wall(demsph_dd) - 1 |",
               "|---|---:|---:|---:|---:|---:|---:|"]
-    by = defaultdict(list)
-    for r in rows:
-        by[(r["model"], float(r["mason"]))].append(r)
     for k in models:
         for m in grid:
             rs = by.get((k, m))
@@ -576,7 +602,13 @@ def main(argv):
                 cmp3 = f"{vol / w3 - 1:+.3f}"
             lines.append(f"| {k} | {m:g} | {len(rs)} | {wall:.4f} | {vol:.4f} | {1 - wall / vol:+.3f} | {cmp3} |")
     lines.append("")
-    pre = crit.get("preregistered_criterion", {}).get("points", [])
+    return lines
+
+
+def preregistered(st):
+    """The pre-registered model-1 criterion on this cell (its training data)."""
+    lines = []
+    pre = st.crit.get("preregistered_criterion", {}).get("points", [])
     if pre:
         lines += ["## The pre-registered model-1 criterion on this cell (training data)", "",
                   "delta = 1 - wall/(volume side + (g(phi) - 1) max(contact virial, 0)) of model 1's seed means "
@@ -588,6 +620,14 @@ def main(argv):
                          f"{q['shortfall']:.3f} ± {q['shortfall_err']:.3f} | {q['mismatch']:.3f} | "
                          f"{q['outcome_10']} | {q['outcome_20']} |")
         lines.append("")
+    return lines
+
+
+def quasistatic(st):
+    """The quasi-static limit beside the lowest-Mn particle stresses."""
+    crit, phi, models, qs, aqs_quote, seed_runs, by = st.crit, st.phi, st.models, st.qs, st.aqs_quote, \
+        st.seed_runs, st.by
+    lines = []
     if qs:
         lines += ["## The quasi-static limit (issue 17)", "",
                   "AQS wall stress of the paper cell (mrf quasistatic; reports/quasistatic/paper/), in φμ0M², beside "
@@ -623,7 +663,13 @@ def main(argv):
             lines.append(f"| {k} | {q['mason']:g} | {(q['stress'] - q['stress_fluid']) / sc:.5f} ± "
                          f"{q['err'] / sc:.5f} | {'–' if math.isnan(vol) else f'{vol:.5f}'} |")
         lines.append("")
-    lines += ["## Flow-curve fits (mrf criterion)", "",
+    return lines
+
+
+def fits(st, open_mn, pstates):
+    """mrf criterion's Bingham and power-law fits, and Delta at low Mn."""
+    crit, phi, models = st.crit, st.phi, st.models
+    lines = ["## Flow-curve fits (mrf criterion)", "",
               "eta/eta_inf = 1 + (Mn*/Mn)^Delta fitted to the seed-combined points (Bingham: Delta = 1). The "
               "Bingham fit's dynamic yield stress is tau_y / (phi mu0 M^2) = eta_r,inf Mn* / (4.5 phi) (REFERENCE.md "
               "§7, Bi = Mn*/Mn), = b/(4.5 phi) with b the fit's coefficient of 1/Mn and its error; "
@@ -649,8 +695,7 @@ def main(argv):
     # Delta at low Mn: eta/eta_inf - 1 ~ Mn^-Delta there, and the particle
     # part is tau - eta_inf gdot, so Delta = 1 - s of the particle part
     # between the two lowest Mn (the claims section's slope)
-    conv_points = arg(argv, "--convergence-points", os.path.join(here, "study", "paper", "convergence", "points"))
-    open_mn, pstates, low_d = coupled_open_at(conv_points, rows, carrier), particle_state(rows), []
+    low_d = []
     for k in models:
         p = sorted(crit["models"][k]["points"], key=lambda q: q["mason"])
         sl = lowest_slopes(p, lambda q: phi * MU0 * q["magnetization"] ** 2)[1] if len(p) >= 2 else None
@@ -663,8 +708,34 @@ def main(argv):
         lines += ["Delta at low Mn, from the particle part between the two lowest Mn (Delta = 1 - s, s its slope in "
                   "the claims section, with its status there; the fit above spans all five Mn): "
                   + "; ".join(low_d) + ".", ""]
-    lines += theory_and_experiment(crit, phi, expt, aqs_quote)
-    low = low_mn(low_rows, crit, phi, aqs_quote, rows)
+    return lines
+
+
+def main(argv):
+    if len(argv) < 3:
+        print(__doc__)
+        return 2
+    st = Study(argv)
+    os.makedirs(st.out, exist_ok=True)
+    crit, phi, rows, here, models, small, small_m = st.crit, st.phi, st.rows, st.here, st.models, st.small, st.small_m
+    stress_figure(st)
+    lines = opening_tables(st)
+    steady_lines, firsts = steadiness(st)
+    lines += steady_lines
+    # the one-window rule's runs are the per-particle ones, in the headline or beside it (the carrier section)
+    pp_low = [r for r in st.carrier if r["carrier"] == "per_particle"] or rows
+    lines += one_window(pp_low, firsts, phi, arg(argv, "--points", os.path.join(here, "study", "paper", "points")))
+    lines += carrier_section(st.carrier, arg(argv, "--common-points", os.path.join(here, "study", "paper",
+                                                                                     "common_low", "points")))
+    lines += cost_section(st, firsts)
+    lines += wall_volume(st)
+    lines += preregistered(st)
+    lines += quasistatic(st)
+    conv_points = arg(argv, "--convergence-points", os.path.join(here, "study", "paper", "convergence", "points"))
+    open_mn, pstates = coupled_open_at(conv_points, rows, st.carrier), particle_state(rows)
+    lines += fits(st, open_mn, pstates)
+    lines += theory_and_experiment(crit, phi, st.expt, st.aqs_quote)
+    low = low_mn(st.low_rows, crit, phi, st.aqs_quote, rows)
     lines += low
     small_crit_path = arg(argv, "--small-criterion", os.path.join(here, "study", "criterion_default.json"))
     small_crit = json.load(open(small_crit_path)) if os.path.exists(small_crit_path) else None
@@ -680,9 +751,9 @@ def main(argv):
                    arg(argv, "--convergence", os.path.join(here, "study", "paper", "convergence.md")), plateau)
     at = lines.index("![stress](stress_vs_mason.png)") + 2
     lines[at:at] = head
-    with open(os.path.join(out, "paper.md"), "w") as f:
+    with open(os.path.join(st.out, "paper.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
-    print(f"-> {os.path.join(out, 'paper.md')}")
+    print(f"-> {os.path.join(st.out, 'paper.md')}")
     return 0
 
 
