@@ -173,7 +173,7 @@ def against_small(q, small_k, phi, small_m):
     return t, e, f"{st:.4f} ± {fe(se)} | {(t - st) / math.hypot(e, se):+.1f}"
 
 
-def answers(crit, small, phi, small_m, pstate, unsteady, claim_lines, cost_line, conv_path, extra=()):
+def answers(crit, small, phi, small_m, pstate, unsteady, claim_lines, cost_line, conv_path, extra=(), swapped=False):
     """The section a reader wants first: the three models' stress at Mn 1e-2
     and 1 on the paper cell and the small cell, how settled each number is,
     the largest numerical lever (the convergence table), what the whole sweep
@@ -209,7 +209,10 @@ def answers(crit, small, phi, small_m, pstate, unsteady, claim_lines, cost_line,
                  if x.startswith("- ")] if "The largest lever per model and Mn" in conv else []
         if lever:
             lines += ["The largest numerical lever (reports/study/paper/convergence.md, one seed per variant, "
-                      "still filling in): " + "; ".join(lever) + ".", ""]
+                      "still filling in): " + "; ".join(lever) + "." + (
+                          " The convergence table's base is the headline with the per-particle carrier; at Mn 1e-3 "
+                          "the headline now takes the common-reference runs, so the eos_common_low rows there "
+                          "measure what that swap changed, not a lever of the headline." if swapped else ""), ""]
     verdicts = defaultdict(lambda: [0, 0])
     for x in claim_lines:
         cells = [c.strip() for c in x.strip("|").split("|")]
@@ -748,7 +751,8 @@ def main(argv):
     cost = next((x for x in lines if x.startswith("Whole-sweep wall time")), "")
     plateau = [f"Model 1 below Mn 1e-3 (its section below): {x}" for x in low if x.startswith("s (3e-4 to 1e-3)")]
     head = answers(crit, small, phi, small_m, particle_state(rows), unsteady, claims, cost,
-                   arg(argv, "--convergence", os.path.join(here, "study", "paper", "convergence.md")), plateau)
+                   arg(argv, "--convergence", os.path.join(here, "study", "paper", "convergence.md")), plateau,
+                   any(r["carrier"] == "common" and r["in_headline"] == "yes" for r in st.carrier))
     at = lines.index("![stress](stress_vs_mason.png)") + 2
     lines[at:at] = head
     with open(os.path.join(st.out, "paper.md"), "w") as f:
