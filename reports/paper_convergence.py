@@ -27,9 +27,9 @@ seeds' starting states with each other (and the coupled ladder with the
 base), so their degrees of freedom, which the column quotes, are an upper
 bound.
 """
+import csv
 import glob
 import json
-import csv
 import math
 import os
 import statistics
@@ -52,8 +52,8 @@ def f(r, k):
 
 
 def seed_sets(paper_dir):
-    """(model, Mn) -> [(seed, stress_total in Pa, magnetization), ...] per
-    seed set of the tolerance ladders: one set per archive and tolerance."""
+    """(model, Mn) -> the seed sets of the tolerance ladders, one per archive
+    and tolerance, each a list of (stress_total in Pa, magnetization)."""
     sets = defaultdict(list)
     for ladder in sorted(glob.glob(os.path.join(paper_dir, "tolerance*", "points"))):
         for tol in sorted(glob.glob(os.path.join(ladder, "*", "tol_*"))):
