@@ -7,7 +7,8 @@
 // full width everywhere.
 //
 // A row's partners are taken a vector at a time from padded copies of the
-// coordinates: loaded and transposed on AVX2, gathered elsewhere; the laws
+// coordinates: loaded and transposed on AVX2 and AVX-512, gathered
+// elsewhere; the laws
 // of forces/ (dipole_x_law, hertz_law_t) evaluated on whole vectors; and
 // the partners' forces decremented in a padded buffer (a row's partners are
 // distinct, so lanes never collide). A pair beyond the range gets 1/r = 0,
@@ -118,8 +119,10 @@ void FreeRowsOf(const DemPairLaws<Dipole, HertzPair>& laws, const Box& box, cons
   // partners' coordinates and forces move by aligned 4-wide loads and
   // stores of them and 4 x 4 transposes (a 4-wide access to the packed Vec3
   // array would overlap the next sphere, and such a load cannot take its
-  // data from a store to that sphere still in flight); elsewhere by gathers
-  // and scatters. The partners' forces collect in fp, added to f at the
+  // data from a store to that sphere still in flight). AVX-512 does the
+  // same with two partners to a vector (its gathers and scatters, 3 + 6 an
+  // 8-pair vector, held the kernel to half the speed: docs/performance.md,
+  // session 43); elsewhere gathers and scatters. The partners' forces collect in fp, added to f at the
   // end. One more sphere, far beyond every range (its r^2 is finite,
   // 1e200 m^2), fills the lanes past the end of a row, where 1/r = 0 gives
   // it no force: a row's last vector needs no scalar tail.
@@ -166,6 +169,19 @@ void FreeRowsOf(const DemPairLaws<Dipole, HertzPair>& laws, const Box& box, cons
       const __m256d t2 = _mm256_unpacklo_pd(q2, q3), t3 = _mm256_unpackhi_pd(q2, q3);
       const V px{_mm256_permute2f128_pd(t0, t2, 0x20)}, py{_mm256_permute2f128_pd(t1, t3, 0x20)},
           pz{_mm256_permute2f128_pd(t0, t2, 0x31)};
+#elif HWY_TARGET == HWY_AVX3
+      // partners l and l + 4 side by side, then the AVX2 transpose in each
+      // half: unpack within 128-bit lanes, then one two-source permute
+      const auto pair_of = [&](std::size_t l) {
+        return _mm512_insertf64x4(_mm512_castpd256_pd512(_mm256_load_pd(xa + 4 * std::size_t{k[l]})),
+                                  _mm256_load_pd(xa + 4 * std::size_t{k[l + 4]}), 1);
+      };
+      const __m512d a0 = pair_of(0), a1 = pair_of(1), a2 = pair_of(2), a3 = pair_of(3);
+      const __m512d t0 = _mm512_unpacklo_pd(a0, a1), t1 = _mm512_unpackhi_pd(a0, a1);  // x0 x1 z0 z1 x4 x5 z4 z5, y..
+      const __m512d t2 = _mm512_unpacklo_pd(a2, a3), t3 = _mm512_unpackhi_pd(a2, a3);  // x2 x3 z2 z3 x6 x7 z6 z7, y..
+      const __m512i even = _mm512_setr_epi64(0, 1, 8, 9, 4, 5, 12, 13), odd = _mm512_setr_epi64(2, 3, 10, 11, 6, 7, 14, 15);
+      const V px{_mm512_permutex2var_pd(t0, even, t2)}, py{_mm512_permutex2var_pd(t1, even, t3)},
+          pz{_mm512_permutex2var_pd(t0, odd, t2)};
 #else
       const auto k4 = hn::ShiftLeft<2>(hn::BitCast(di, hn::PromoteTo(du64, hn::LoadU(du, k))));  // x of k in xp
       const auto px = hn::GatherIndex(d, xa, k4), py = hn::GatherIndex(d, xa + 1, k4),
@@ -221,6 +237,23 @@ void FreeRowsOf(const DemPairLaws<Dipole, HertzPair>& laws, const Box& box, cons
         for (std::size_t l = 0; l < 4; ++l) {
           double* fk = fa + 4 * std::size_t{k[l]};
           _mm256_store_pd(fk, _mm256_sub_pd(_mm256_load_pd(fk), g4[l]));
+        }
+      }
+#elif HWY_TARGET == HWY_AVX3
+      {  // the transpose back: (gx, gy, gz, 0) of partners l and l + 2 in one vector, each half subtracted from its row of fp
+        const __m512d u0 = _mm512_unpacklo_pd(gx.raw, gy.raw), u1 = _mm512_unpackhi_pd(gx.raw, gy.raw);
+        const __m512d u2 = _mm512_unpacklo_pd(gz.raw, _mm512_setzero_pd()),
+                      u3 = _mm512_unpackhi_pd(gz.raw, _mm512_setzero_pd());
+        const __m512i first = _mm512_setr_epi64(0, 1, 8, 9, 2, 3, 10, 11), second = _mm512_setr_epi64(4, 5, 12, 13, 6, 7, 14, 15);
+        const __m512d g02 = _mm512_permutex2var_pd(u0, first, u2), g46 = _mm512_permutex2var_pd(u0, second, u2);
+        const __m512d g13 = _mm512_permutex2var_pd(u1, first, u3), g57 = _mm512_permutex2var_pd(u1, second, u3);
+        const __m256d g8[8] = {_mm512_castpd512_pd256(g02), _mm512_castpd512_pd256(g13),
+                               _mm512_extractf64x4_pd(g02, 1), _mm512_extractf64x4_pd(g13, 1),
+                               _mm512_castpd512_pd256(g46), _mm512_castpd512_pd256(g57),
+                               _mm512_extractf64x4_pd(g46, 1), _mm512_extractf64x4_pd(g57, 1)};
+        for (std::size_t l = 0; l < 8; ++l) {  // lanes of the dummy write the same 0 - 0 to the same place
+          double* fk = fa + 4 * std::size_t{k[l]};
+          _mm256_store_pd(fk, _mm256_sub_pd(_mm256_load_pd(fk), g8[l]));
         }
       }
 #else
