@@ -120,12 +120,13 @@ void FreeRowsOf(const DemPairLaws<Dipole, HertzPair>& laws, const Box& box, cons
   // stores of them and 4 x 4 transposes (a 4-wide access to the packed Vec3
   // array would overlap the next sphere, and such a load cannot take its
   // data from a store to that sphere still in flight). AVX-512 does the
-  // same with two partners to a vector (its gathers and scatters, 3 + 6 an
-  // 8-pair vector, held the kernel to half the speed: docs/performance.md,
-  // session 43); elsewhere gathers and scatters. The partners' forces collect in fp, added to f at the
-  // end. One more sphere, far beyond every range (its r^2 is finite,
-  // 1e200 m^2), fills the lanes past the end of a row, where 1/r = 0 gives
-  // it no force: a row's last vector needs no scalar tail.
+  // same with two partners to a register (its gathers and scatters, 3 + 6
+  // per 8-pair vector, held the kernel to half the speed:
+  // docs/performance.md, session 43); other targets gather and scatter.
+  // The partners' forces collect in fp, added to f at the end. One more
+  // sphere, far beyond every range (its r^2 is finite, 1e200 m^2), fills
+  // the lanes past the end of a row, where 1/r = 0 gives it no force: a
+  // row's last vector needs no scalar tail.
   struct alignas(32) Padded {
     double v[4];
   };
@@ -179,7 +180,8 @@ void FreeRowsOf(const DemPairLaws<Dipole, HertzPair>& laws, const Box& box, cons
       const __m512d a0 = pair_of(0), a1 = pair_of(1), a2 = pair_of(2), a3 = pair_of(3);
       const __m512d t0 = _mm512_unpacklo_pd(a0, a1), t1 = _mm512_unpackhi_pd(a0, a1);  // x0 x1 z0 z1 x4 x5 z4 z5, y..
       const __m512d t2 = _mm512_unpacklo_pd(a2, a3), t3 = _mm512_unpackhi_pd(a2, a3);  // x2 x3 z2 z3 x6 x7 z6 z7, y..
-      const __m512i even = _mm512_setr_epi64(0, 1, 8, 9, 4, 5, 12, 13), odd = _mm512_setr_epi64(2, 3, 10, 11, 6, 7, 14, 15);
+      const __m512i even = _mm512_setr_epi64(0, 1, 8, 9, 4, 5, 12, 13);
+      const __m512i odd = _mm512_setr_epi64(2, 3, 10, 11, 6, 7, 14, 15);
       const V px{_mm512_permutex2var_pd(t0, even, t2)}, py{_mm512_permutex2var_pd(t1, even, t3)},
           pz{_mm512_permutex2var_pd(t0, odd, t2)};
 #else
@@ -240,11 +242,13 @@ void FreeRowsOf(const DemPairLaws<Dipole, HertzPair>& laws, const Box& box, cons
         }
       }
 #elif HWY_TARGET == HWY_AVX3
-      {  // the transpose back: (gx, gy, gz, 0) of partners l and l + 2 in one vector, each half subtracted from its row of fp
+      {  // the transpose back: (gx, gy, gz, 0) of partners l and l + 2 in one
+         // register, each half subtracted from its partner's row of fp
         const __m512d u0 = _mm512_unpacklo_pd(gx.raw, gy.raw), u1 = _mm512_unpackhi_pd(gx.raw, gy.raw);
         const __m512d u2 = _mm512_unpacklo_pd(gz.raw, _mm512_setzero_pd()),
                       u3 = _mm512_unpackhi_pd(gz.raw, _mm512_setzero_pd());
-        const __m512i first = _mm512_setr_epi64(0, 1, 8, 9, 2, 3, 10, 11), second = _mm512_setr_epi64(4, 5, 12, 13, 6, 7, 14, 15);
+        const __m512i first = _mm512_setr_epi64(0, 1, 8, 9, 2, 3, 10, 11);
+        const __m512i second = _mm512_setr_epi64(4, 5, 12, 13, 6, 7, 14, 15);
         const __m512d g02 = _mm512_permutex2var_pd(u0, first, u2), g46 = _mm512_permutex2var_pd(u0, second, u2);
         const __m512d g13 = _mm512_permutex2var_pd(u1, first, u3), g57 = _mm512_permutex2var_pd(u1, second, u3);
         const __m256d g8[8] = {_mm512_castpd512_pd256(g02), _mm512_castpd512_pd256(g13),
