@@ -129,6 +129,48 @@ def open_mn_failures(root, work):
     return out
 
 
+def long_failures(root, work):
+    """reports/paper_model1_seeds.py's reading of the long runs of model 3 at
+    Mn 0.1 (experiments/sweeps/paper_mn01_long.toml) on runs whose answer is
+    known. Two long runs at 150 and 154 Pa (+-0.2, each window falling
+    linearly by 0.001 Pa per strain unit through it, sampled at the middle
+    of every strain unit of 400-800): L = 152 +- max(hypot(0.2, 0.2) / 2,
+    sd / sqrt 2 = 2) = 152.00 +- 2.00, each run's halves differing by
+    200 * 0.001 / (2 * 0.2) = +0.50 of its own errors. Six seeds at 160-165
+    Pa: P = 162.50 +- 1.8708 / sqrt 6 = 0.76, so P - L = +10.50 Pa = +4.90
+    combined errors, over the threshold of 2: not converged, and with model
+    1 at 125 +- 0.1 (two seeds, no scatter: its error hypot(0.1, 0.1) / 2)
+    D_1 = 125 / 152 - 1 = -0.178 +- 0.011, outside the bound of -0.27. Long
+    runs at 160 and 162 Pa instead: L = 161.00 +- 1.00, +1.19 combined
+    errors, P stands."""
+    sys.path.insert(0, os.path.join(root, "reports"))
+    import paper_model1_seeds as seeds
+    six = [{"stress_total": 160.0 + k, "stress_total_err": 0.1} for k in range(6)]
+    model1 = [{"stress_total": 125.0, "stress_total_err": 0.1}] * 2
+    fails = []
+    for case, levels, want in (("converged", (150.0, 154.0),
+                                ("| 7 | 150.00 ± 0.20 |", "| +0.50 |", "L = 152.00 ± 2.00 Pa (2 of 2 runs)",
+                                 "P = 162.50 ± 0.76 Pa", "= +4.90 combined", "**model 3 at Mn 0.1 is not converged",
+                                 "= -0.178 ± 0.011", "**outside**")),
+                               ("stands", (160.0, 162.0), ("L = 161.00 ± 1.00 Pa", "= +1.19 combined", "P stands"))):
+        paper = os.path.join(work, "long_" + case)
+        shutil.rmtree(paper, ignore_errors=True)
+        for seed, level in zip((7, 8), levels):
+            d = os.path.join(paper, "mn01_long", "points", "demsph_dd", f"mn_0.1_seed_{seed}")
+            os.makedirs(d)
+            with open(os.path.join(d, "summary.json"), "w") as fh:
+                json.dump({"stress_total": level, "stress_total_err": 0.2, "stress_total_drift_z": -0.1,
+                           "steady_mser_discard_fraction": 0.0, "warmup_strain": 400.0, "strain": 800.0}, fh)
+            with open(os.path.join(d, "window_series.csv"), "w") as fh:
+                fh.write("strain,stress_total_Pa\n")
+                for k in range(400):
+                    x = 400.5 + k
+                    fh.write(f"{x!r},{level + 0.001 * (x - 600.0)!r}\n")
+        text = "\n".join(seeds.model3_long(paper, False, six, model1))
+        fails += [f"long runs, {case}: want '{w}' in the reading" for w in want if w not in text]
+    return fails
+
+
 def pooled_failures(root, work, py):
     """reports/paper_convergence.py's 'pooled' reading on a point whose
     answer is known: model 3 at Mn 1, a base of three seeds (1.00, 1.01,
@@ -401,10 +443,11 @@ def main(argv):
         check("one-window second half, in its error", float(cells[9]), ONE_WINDOW_SLOPE * 8.05 / (0.005 * tau1), 0.06)
     failures += pooled_failures(root, work, py)
     # (in the interpreter that has matplotlib, which paper_rules imports through study.py)
-    res = subprocess.run([py, os.path.abspath(__file__), "--open-mn", root, work], capture_output=True, text=True)
-    failures += [x for x in res.stdout.splitlines() if x.startswith("open Mn 1e-3 rule")]
-    if res.returncode != 0:
-        failures.append(f"open Mn 1e-3 rule: the check did not run: {res.stderr.strip()[-300:]}")
+    for mode, tag in (("--open-mn", "open Mn 1e-3 rule"), ("--long", "long runs")):
+        res = subprocess.run([py, os.path.abspath(__file__), mode, root, work], capture_output=True, text=True)
+        failures += [x for x in res.stdout.splitlines() if x.startswith(tag)]
+        if res.returncode != 0:
+            failures.append(f"{tag}: the check did not run: {res.stderr.strip()[-300:]}")
     for f in failures:
         print("FAIL:", f)
     print(f"paper report check: {len(failures)} failure(s)")
@@ -414,5 +457,8 @@ def main(argv):
 if __name__ == "__main__":
     if sys.argv[1:2] == ["--open-mn"]:
         print("\n".join(open_mn_failures(sys.argv[2], sys.argv[3])))
+        sys.exit(0)
+    if sys.argv[1:2] == ["--long"]:
+        print("\n".join(long_failures(sys.argv[2], sys.argv[3])))
         sys.exit(0)
     sys.exit(main(sys.argv))
