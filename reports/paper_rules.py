@@ -271,6 +271,78 @@ def low_mn_rows(argv, here):
     return [r for r in read_rows(path) if r["status"] == "ok" and r["model"] == "dem_stokes"]
 
 
+def low_long_rows(argv, here):
+    """Model 1's finished runs of experiments/sweeps/paper_model1_low_long.toml
+    (its own sweep.csv, collected by scripts/paper_interim.py), None without it."""
+    path = arg(argv, "--low-long", os.path.join(here, "study", "paper", "model1_low_long", "sweep.csv"))
+    if not os.path.exists(path):
+        return None
+    return [r for r in read_rows(path) if r["status"] == "ok" and r["model"] == "dem_stokes"]
+
+
+LOW_LONG = "paper_model1_low_long"  # its runs' sweep name in transients.csv
+
+
+def slope_between(lo_rows, hi_rows, phi, lo=3e-4, hi=1e-3):
+    """The particle part's slope s = ln(v_hi / v_lo) / ln(hi / lo) between two
+    points of seed-combined runs (seed_combined), and its error."""
+    v_lo, e_lo, _, _ = seed_combined(lo_rows, phi)
+    v_hi, e_hi, _, _ = seed_combined(hi_rows, phi)
+    lr = math.log(hi / lo)
+    return math.log(v_hi / v_lo) / lr, math.hypot(e_lo / v_lo, e_hi / v_hi) / lr
+
+
+def plateau_verdict(slope, err):
+    return ("is flat (a plateau)" if abs(slope) <= 2 * err else
+            "falls toward the quasi-static value" if slope > 0 else "rises as Mn falls")
+
+
+def low_long(rows, transients, phi):
+    """experiments/sweeps/paper_model1_low_long.toml, read as fixed there
+    before its runs (session 39). Q1 per Mn: d = a run's particle part over
+    strain 16-48 less that over 4-12 (plain means of its 4-unit bins in
+    transients.csv), b = the seeds' mean d, SE = SD(d) / sqrt(n); |b| > 2 SE
+    says the 12-unit window (4-12) was not settled. Q2: the particle part's
+    slope between 3e-4 and 1e-3 from these runs' 16-48 windows alone, read as
+    low_mn reads it. At least 2 seeds per Mn, else not read."""
+    if rows is None:
+        return []
+    lines = ["### Model 1 over long windows at Mn 3e-4 and 1e-3", "",
+             "experiments/sweeps/paper_model1_low_long.toml (fixed before its runs, session 39): model 1, seeds 1-3, "
+             "48 strain units with 16 of warm-up; its reading is in that file. Particle part = total less fluid part.",
+             "", "| Mn | seed | particle part 4-12 (Pa) | 16-48 (Pa) | d (Pa) | drift z | MSER-5 | steady |",
+             "|---:|---:|---:|---:|---:|---:|---:|---|"]
+    by_mn = {m: sorted((r for r in rows if mkey(r["mason"]) == m), key=lambda r: int(r["seed"])) for m in (3e-4, 1e-3)}
+    q1 = []
+    for m, group in by_mn.items():
+        ds = []
+        for r in group:
+            bins = [t for t in transients if t["sweep"] == LOW_LONG and mkey(t["mason"]) == m and t["seed"] == r["seed"]]
+            part = lambda a, b: [num(t, "stress_particles_Pa") for t in bins  # noqa: E731
+                                 if num(t, "strain_lo") >= a - 1e-9 and num(t, "strain_hi") <= b + 1e-9]
+            early, late = part(4, 12), part(16, 48)
+            d = statistics.mean(late) - statistics.mean(early) if early and late else float("nan")
+            if math.isfinite(d):
+                ds.append(d)
+            lines.append(f"| {m:g} | {r['seed']} | " + (f"{statistics.mean(early):.2f}" if early else "no bins") + " | "
+                         + (f"{statistics.mean(late):.2f}" if late else "no bins") + f" | {d:+.2f} | "
+                         f"{num(r, 'stress_total_drift_z'):+.2f} | {num(r, 'steady_mser_discard_fraction'):.3f} | "
+                         + ("yes" if steady(r) else "**no**") + " |")
+        if len(ds) < 2:
+            q1.append(f"Q1 at Mn {m:g}: {len(ds)} run(s) with both windows: not read (at least 2).")
+            continue
+        b, se = statistics.mean(ds), statistics.stdev(ds) / math.sqrt(len(ds))
+        q1.append(f"Q1 at Mn {m:g}: b = {b:+.2f} ± {se:.2f} Pa ({len(ds)} seeds): the 12-unit window "
+                  + ("**was not settled**" if abs(b) > 2 * se else "was settled") + " by the reading fixed in advance.")
+    lines += [""] + q1 + [""]
+    if min(len(g) for g in by_mn.values()) < 2:
+        return lines + [f"Q2: {len(by_mn[3e-4])} and {len(by_mn[1e-3])} runs at Mn 3e-4 and 1e-3: not read (at least 2 "
+                        "each).", ""]
+    slope, err = slope_between(by_mn[3e-4], by_mn[1e-3], phi)
+    return lines + [f"s (3e-4 to 1e-3, 16-48 windows) = {slope:+.3f} ± {err:.3f}: by the reading fixed in advance, the "
+                    f"particle stress **{plateau_verdict(slope, err)}**.", ""]
+
+
 def low_mn(rows, crit, phi, aqs_quote, main_rows=()):
     """Model 1 at Mn 3e-4 (experiments/sweeps/paper_low_mn.toml; rows from
     low_mn_rows, None without its table), read as that file fixed before its
@@ -295,8 +367,7 @@ def low_mn(rows, crit, phi, aqs_quote, main_rows=()):
     bv, be = (base["stress"] - base["stress_fluid"]) / bs, base["err"] / bs
     lr = math.log(1e-3 / 3e-4)
     slope, slope_err = math.log(bv / mean) / lr, math.hypot(err / mean, be / bv) / lr
-    verdict = ("is flat (a plateau)" if abs(slope) <= 2 * slope_err else
-               "falls toward the quasi-static value" if slope > 0 else "rises as Mn falls")
+    verdict = plateau_verdict(slope, slope_err)
     bad = [r["seed"] for r in rows if not steady(r)]
     pfail = [r["seed"] for r in rows if particle_rule(r) not in ("ok", "untested")]
     lines += ["| Mn | seeds | particle part | note |", "|---:|---:|---:|---|",

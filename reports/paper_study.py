@@ -21,6 +21,8 @@ usage: paper_study.py SWEEP_DIR OUT_DIR [--small reports/study/flow_curves.csv]
                       [--reanalysed reports/study/paper/reanalysed.json]
                       [--convergence reports/study/paper/convergence.md]
                       [--low-mn reports/study/paper/low_mn_sweep.csv]
+                      [--low-long reports/study/paper/model1_low_long/sweep.csv]
+                      [--transients reports/study/paper/transients.csv]
                       [--carrier reports/study/paper/low_carrier.csv]
                       [--common-points reports/study/paper/common_low/points]
 
@@ -52,6 +54,10 @@ reading of the particle-part rule on runs that carry the plain estimate.
 --low-mn: model 1 at Mn 3e-4 (experiments/sweeps/paper_low_mn.toml, collected
 from reports/study/paper/low_mn_points by scripts/paper_interim.py), read
 by the rule that sweep file fixed before its runs.
+--low-long, --transients: model 1's long windows at Mn 3e-4 and 1e-3
+(experiments/sweeps/paper_model1_low_long.toml, collected by
+scripts/paper_interim.py) and the binned whole runs that its first question
+reads (reports/paper_transients.py), read by the rule that sweep file fixed.
 --carrier: the coupled runs at Mn 1e-3 under the per-particle carrier and
 the common EOS reference (scripts/paper_interim.py writes it; columns
 carrier and in_headline), tabulated side by side (reports/paper_carrier.py);
@@ -79,9 +85,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from paper_carrier import carrier_section, one_window  # noqa: E402
-from paper_rules import (DRIFT_Z, MIN_INDEPENDENT, MSER_MAX, arg, coupled_open_at, fe, low_mn,  # noqa: E402
-                         low_mn_rows, lowest_slopes, mkey, old_claims, particle_note, particle_rule,
-                         particle_state, seed_combined, slope_status, steady)
+from paper_rules import (DRIFT_Z, MIN_INDEPENDENT, MSER_MAX, arg, coupled_open_at, fe, low_long,  # noqa: E402
+                         low_long_rows, low_mn, low_mn_rows, lowest_slopes, mkey, old_claims, particle_note,
+                         particle_rule, particle_state, seed_combined, slope_status, steady)
 from study import (CHAIN_YIELD, COLOR, GINDER_SAT, LABEL, MN_CONVENTION, MU0, ORDER,  # noqa: E402
                    experiment_points, num, read_rows, save)
 
@@ -361,6 +367,8 @@ class Study:
         self.gdot = num(self.rows[0], "shear_rate") if self.rows else float("nan")
         self.grid = [1e-3, 1e-2, 0.1, 1.0, 10.0]
         self.low_rows = low_mn_rows(argv, here)  # model 1 below Mn 1e-3
+        # the long runs' binned transients (reports/paper_transients.py)
+        self.transients = arg(argv, "--transients", os.path.join(here, "study", "paper", "transients.csv"))
         self.by = defaultdict(list)  # (model, Mn) -> its runs
         for r in self.rows:
             self.by[(r["model"], float(r["mason"]))].append(r)
@@ -739,7 +747,9 @@ def main(argv):
     lines += fits(st, open_mn, pstates)
     lines += theory_and_experiment(crit, phi, st.expt, st.aqs_quote)
     low = low_mn(st.low_rows, crit, phi, st.aqs_quote, rows)
-    lines += low
+    long_lines = low_long(low_long_rows(argv, here), read_rows(st.transients) if os.path.exists(st.transients) else [],
+                          phi)
+    lines += low + long_lines
     small_crit_path = arg(argv, "--small-criterion", os.path.join(here, "study", "criterion_default.json"))
     small_crit = json.load(open(small_crit_path)) if os.path.exists(small_crit_path) else None
     claims = old_claims(crit, small_crit, phi, small_m, pstates, open_mn)
@@ -749,7 +759,7 @@ def main(argv):
     for r in rows:
         unsteady[(r["model"], mkey(r["mason"]))] += 0 if steady(r) else 1
     cost = next((x for x in lines if x.startswith("Whole-sweep wall time")), "")
-    plateau = [f"Model 1 below Mn 1e-3 (its section below): {x}" for x in low if x.startswith("s (3e-4 to 1e-3)")]
+    plateau = [f"Model 1 below Mn 1e-3 (its section below): {x}" for x in low + long_lines if x.startswith("s (3e-4 to 1e-3")]
     head = answers(crit, small, phi, small_m, pstates, unsteady, claims, cost,
                    arg(argv, "--convergence", os.path.join(here, "study", "paper", "convergence.md")), plateau,
                    any(r["carrier"] == "common" and r["in_headline"] == "yes" for r in st.carrier))

@@ -239,6 +239,15 @@ def main():
         out = os.path.join("out", "sweeps", "paper_low_mn_interim")
         collect(mrf, os.path.join(sweeps, "paper_low_mn.toml"), src["paper_low_mn"], out)
         shutil.copy(os.path.join(out, "sweep.csv"), os.path.join(paper, "low_mn_sweep.csv"))
+    # model 1's long windows at Mn 3e-4 and 1e-3 (paper_model1_low_long.toml): its own sweep.csv
+    if "--runs" in sys.argv:
+        low_long = os.path.join("out", "sweeps", "paper_model1_low_long")
+    else:
+        low_long = f"{paper}/model1_low_long/points"
+    if os.path.isdir(low_long):
+        out = os.path.join("out", "sweeps", "paper_model1_low_long_interim")
+        collect(mrf, os.path.join(sweeps, "paper_model1_low_long.toml"), low_long, out)
+        shutil.copy(os.path.join(out, "sweep.csv"), os.path.join(paper, "model1_low_long", "sweep.csv"))
     # the convergence variants against the realistic path's seed means
     out = os.path.join("out", "sweeps", "paper_convergence_interim")
     collect(mrf, os.path.join(sweeps, "paper_convergence.toml"), src["paper_convergence"], out)
