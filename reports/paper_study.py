@@ -760,7 +760,7 @@ def main(argv):
         unsteady[(r["model"], mkey(r["mason"]))] += 0 if steady(r) else 1
     cost = next((x for x in lines if x.startswith("Whole-sweep wall time")), "")
     plateau = [f"Model 1 below Mn 1e-3 (its section below): {x}" for x in low + long_lines
-               if x.startswith(("s (3e-4 to 1e-3", "Q1 at Mn"))]
+               if x.startswith("s (3e-4 to 1e-3") or (x.startswith("Q1 at Mn") and " b = " in x)]
     head = answers(crit, small, phi, small_m, pstates, unsteady, claims, cost,
                    arg(argv, "--convergence", os.path.join(here, "study", "paper", "convergence.md")), plateau,
                    any(r["carrier"] == "common" and r["in_headline"] == "yes" for r in st.carrier))
