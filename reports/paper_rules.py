@@ -325,8 +325,8 @@ def low_long(rows, transients, phi):
             if math.isfinite(d):
                 ds.append(d)
             lines.append(f"| {m:g} | {r['seed']} | " + (f"{statistics.mean(early):.2f}" if early else "no bins") + " | "
-                         + (f"{statistics.mean(late):.2f}" if late else "no bins") + f" | {d:+.2f} | "
-                         f"{num(r, 'stress_total_drift_z'):+.2f} | {num(r, 'steady_mser_discard_fraction'):.3f} | "
+                         + (f"{statistics.mean(late):.2f}" if late else "no bins") + " | "
+                         + (f"{d:+.2f}" if math.isfinite(d) else "-") + f" | {num(r, 'stress_total_drift_z'):+.2f} | {num(r, 'steady_mser_discard_fraction'):.3f} | "
                          + ("yes" if steady(r) else "**no**") + " |")
         if len(ds) < 2:
             q1.append(f"Q1 at Mn {m:g}: {len(ds)} run(s) with both windows: not read (at least 2).")
